@@ -1,0 +1,333 @@
+!> VTK XML output of cubic-triangle meshes for ParaView (and meshio).
+!>
+!> One .vtu per frame: an UnstructuredGrid of VTK_LAGRANGE_TRIANGLE cells (type 69), whose
+!> 10-point order is casca's own (3 vertices, edge 1-2, edge 2-3, edge 3-1, centroid), so the
+!> connectivity is written unpermuted. Array data goes in one AppendedData block, encoding "raw":
+!> each array is a UInt64 byte count followed by the values in native byte order (declared in
+!> byte_order), which is the smallest and fastest form ParaView reads, and meshio reads too.
+!> A .pvd collection lists the frames with their times.
+!>
+!> Every file is written to <path>.part and renamed onto <path> only when complete and closed,
+!> so a reader (or a crash) never sees a half-written file under the final name. rename(2) on
+!> one file system replaces the target atomically.
+module casca_vtu_writer
+  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+  use, intrinsic :: iso_fortran_env, only: int8, int32, int64
+  use casca_kinds, only: dp
+  use casca_error, only: error_t, fatal_error
+  implicit none
+  private
+  public :: field_t, field, write_vtu, write_pvd
+
+  !> A named array of point or cell data: v(ncomp, n), n = number of points or cells.
+  type :: field_t
+    character(len=:), allocatable :: name
+    real(dp), allocatable :: v(:, :)
+  end type field_t
+
+  integer, parameter :: vtk_lagrange_triangle = 69
+  integer, parameter :: nen = 10          !< points per cubic triangle
+  integer, parameter :: msg_len = 512
+  character(len=*), parameter :: nl = achar(10)
+
+  interface itoa
+    module procedure itoa_i32, itoa_i64
+  end interface itoa
+
+  interface
+    !> C library rename(): Fortran 2008 has no standard way to rename a file.
+    function c_rename(old, new) bind(c, name='rename') result(stat)
+      import :: c_char, c_int
+      character(kind=c_char), intent(in) :: old(*), new(*)
+      integer(c_int) :: stat
+    end function c_rename
+  end interface
+
+contains
+
+  !> Build a field_t (so callers can write field('thickness', reshape(t, [1, n]))).
+  pure function field(name, v) result(f)
+    character(len=*), intent(in) :: name
+    real(dp), intent(in) :: v(:, :)
+    type(field_t) :: f
+    f%name = name
+    allocate (f%v, source=v)   ! (plain f%v = v trips a spurious gfortran 12 warning)
+  end function field
+
+  !> Write one UnstructuredGrid of cubic triangles to path (.vtu).
+  !> x(3, nnode) coordinates; conn(10, nelem) 1-based node numbers in casca order;
+  !> point_fields(:)%v(ncomp, nnode), cell_fields(:)%v(ncomp, nelem); either may be size 0.
+  subroutine write_vtu(path, x, conn, point_fields, cell_fields, err)
+    character(len=*), intent(in) :: path
+    real(dp), intent(in) :: x(:, :)
+    integer, intent(in) :: conn(:, :)
+    type(field_t), intent(in) :: point_fields(:), cell_fields(:)
+    type(error_t), allocatable, intent(out) :: err
+
+    character(len=:), allocatable :: xml, tmp
+    character(len=msg_len) :: msg
+    integer(int64) :: offset
+    integer(int64), allocatable :: cell_offsets(:)
+    integer(int8), allocatable :: types(:)
+    integer :: nnode, nelem, i, u, ios
+
+    nnode = size(x, 2)
+    nelem = size(conn, 2)
+    if (size(x, 1) /= 3) then
+      call fatal_error(err, 'write_vtu: '//trim(path)//': x must have 3 rows, got ' &
+                       //itoa(size(x, 1)))
+      return
+    end if
+    if (size(conn, 1) /= nen) then
+      call fatal_error(err, 'write_vtu: '//trim(path)//': conn must have 10 rows, got ' &
+                       //itoa(size(conn, 1)))
+      return
+    end if
+    ! A bad node number would make ParaView read out of bounds or silently draw garbage.
+    if (nelem > 0) then
+      if (minval(conn) < 1 .or. maxval(conn) > nnode) then
+        call fatal_error(err, 'write_vtu: '//trim(path)//': node number out of range 1..' &
+                         //itoa(nnode)//' in conn')
+        return
+      end if
+    end if
+    call check_fields(path, 'point', point_fields, nnode, err)
+    if (allocated(err)) return
+    call check_fields(path, 'cell', cell_fields, nelem, err)
+    if (allocated(err)) return
+
+    ! XML header. Offsets count bytes from just after the '_' that opens the appended data;
+    ! each block is an 8-byte (UInt64) length followed by the values.
+    offset = 0
+    xml = '<?xml version="1.0"?>'//nl &
+          //'<VTKFile type="UnstructuredGrid" version="1.0" byte_order="'//byte_order() &
+          //'" header_type="UInt64">'//nl &
+          //'  <UnstructuredGrid>'//nl &
+          //'    <Piece NumberOfPoints="'//itoa(nnode)//'" NumberOfCells="'//itoa(nelem)//'">'//nl
+    if (size(point_fields) > 0) then
+      xml = xml//'      <PointData>'//nl
+      do i = 1, size(point_fields)
+        xml = xml//data_array('Float64', point_fields(i)%name, size(point_fields(i)%v, 1), &
+                              offset, 8_int64*size(point_fields(i)%v, kind=int64))
+      end do
+      xml = xml//'      </PointData>'//nl
+    end if
+    if (size(cell_fields) > 0) then
+      xml = xml//'      <CellData>'//nl
+      do i = 1, size(cell_fields)
+        xml = xml//data_array('Float64', cell_fields(i)%name, size(cell_fields(i)%v, 1), &
+                              offset, 8_int64*size(cell_fields(i)%v, kind=int64))
+      end do
+      xml = xml//'      </CellData>'//nl
+    end if
+    xml = xml//'      <Points>'//nl &
+          //data_array('Float64', 'Points', 3, offset, 8_int64*3*nnode) &
+          //'      </Points>'//nl &
+          //'      <Cells>'//nl &
+          //data_array('Int64', 'connectivity', 1, offset, 8_int64*nen*nelem) &
+          //data_array('Int64', 'offsets', 1, offset, 8_int64*nelem) &
+          //data_array('UInt8', 'types', 1, offset, 1_int64*nelem) &
+          //'      </Cells>'//nl &
+          //'    </Piece>'//nl &
+          //'  </UnstructuredGrid>'//nl &
+          //'  <AppendedData encoding="raw">'//nl//'   _'
+
+    ! VTK's offsets array holds the end of each cell's run in connectivity (no leading 0).
+    cell_offsets = [(int(nen, int64)*i, i=1, nelem)]
+    types = [(int(vtk_lagrange_triangle, int8), i=1, nelem)]
+
+    tmp = trim(path)//'.part'
+    open (newunit=u, file=tmp, access='stream', form='unformatted', status='replace', &
+          action='write', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call fatal_error(err, 'write_vtu: cannot open '//tmp//' for writing: '//trim(msg))
+      return
+    end if
+
+    ! Same order as the offsets assigned above. The meshio reader needs the data block to
+    ! be followed directly by a newline.
+    write (u, iostat=ios, iomsg=msg) xml
+    do i = 1, size(point_fields)
+      if (ios == 0) write (u, iostat=ios, iomsg=msg) &
+        nbytes(8, size(point_fields(i)%v, kind=int64)), point_fields(i)%v
+    end do
+    do i = 1, size(cell_fields)
+      if (ios == 0) write (u, iostat=ios, iomsg=msg) &
+        nbytes(8, size(cell_fields(i)%v, kind=int64)), cell_fields(i)%v
+    end do
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, size(x, kind=int64)), x
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) &
+      nbytes(8, size(conn, kind=int64)), int(conn, int64) - 1_int64   ! VTK numbers from 0
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, int(nelem, int64)), cell_offsets
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(1, int(nelem, int64)), types
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nl//'  </AppendedData>'//nl//'</VTKFile>'//nl
+
+    call finish(u, ios, msg, tmp, trim(path), 'write_vtu', err)
+  end subroutine write_vtu
+
+  !> Write a ParaView collection (.pvd) listing files(i) (names relative to the .pvd's folder)
+  !> at times(i). Rewritten whole on every call so that it is valid after every frame.
+  subroutine write_pvd(path, files, times, err)
+    character(len=*), intent(in) :: path
+    character(len=*), intent(in) :: files(:)
+    real(dp), intent(in) :: times(:)
+    type(error_t), allocatable, intent(out) :: err
+
+    character(len=:), allocatable :: xml, tmp
+    character(len=msg_len) :: msg
+    character(len=32) :: tbuf
+    integer :: i, u, ios
+
+    if (size(files) /= size(times)) then
+      call fatal_error(err, 'write_pvd: '//trim(path)//': '//itoa(size(files))//' files but ' &
+                       //itoa(size(times))//' times')
+      return
+    end if
+
+    xml = '<?xml version="1.0"?>'//nl &
+          //'<VTKFile type="Collection" version="0.1" byte_order="'//byte_order()//'">'//nl &
+          //'  <Collection>'//nl
+    do i = 1, size(files)
+      ! 17 significant digits so the time read back is the same double.
+      write (tbuf, '(es25.16e3)') times(i)
+      xml = xml//'    <DataSet timestep="'//trim(adjustl(tbuf))//'" group="" part="0" file="' &
+            //xml_escape(trim(files(i)))//'"/>'//nl
+    end do
+    xml = xml//'  </Collection>'//nl//'</VTKFile>'//nl
+
+    tmp = trim(path)//'.part'
+    open (newunit=u, file=tmp, access='stream', form='unformatted', status='replace', &
+          action='write', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call fatal_error(err, 'write_pvd: cannot open '//tmp//' for writing: '//trim(msg))
+      return
+    end if
+    write (u, iostat=ios, iomsg=msg) xml
+    call finish(u, ios, msg, tmp, trim(path), 'write_pvd', err)
+  end subroutine write_pvd
+
+  !> Close the temporary file and move it onto its final name; on any failure delete it.
+  subroutine finish(u, ios_write, msg_write, tmp, path, who, err)
+    integer, intent(in) :: u, ios_write
+    character(len=*), intent(in) :: msg_write, tmp, path, who
+    type(error_t), allocatable, intent(out) :: err
+    character(len=msg_len) :: msg
+    integer :: ios, tmp_unit
+
+    if (ios_write /= 0) then
+      close (u, status='delete', iostat=ios)
+      call fatal_error(err, who//': error writing '//tmp//': '//trim(msg_write))
+      return
+    end if
+    close (u, status='keep', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call fatal_error(err, who//': error closing '//tmp//': '//trim(msg))
+      return
+    end if
+    if (c_rename(tmp//c_null_char, path//c_null_char) /= 0) then
+      ! Do not leave the complete-looking temporary behind.
+      open (newunit=tmp_unit, file=tmp, status='old', iostat=ios)
+      if (ios == 0) close (tmp_unit, status='delete', iostat=ios)
+      call fatal_error(err, who//': cannot rename '//tmp//' to '//path)
+      return
+    end if
+  end subroutine finish
+
+  !> Check names and shapes of point or cell fields against n points or cells.
+  subroutine check_fields(path, kind_name, fields, n, err)
+    character(len=*), intent(in) :: path, kind_name
+    type(field_t), intent(in) :: fields(:)
+    integer, intent(in) :: n
+    type(error_t), allocatable, intent(out) :: err
+    integer :: i
+
+    do i = 1, size(fields)
+      if (.not. allocated(fields(i)%name) .or. .not. allocated(fields(i)%v)) then
+        call fatal_error(err, 'write_vtu: '//trim(path)//': '//kind_name//' field '//itoa(i) &
+                         //' has no name or no values')
+        return
+      end if
+      if (len_trim(fields(i)%name) == 0) then
+        call fatal_error(err, 'write_vtu: '//trim(path)//': '//kind_name//' field '//itoa(i) &
+                         //' has an empty name')
+        return
+      end if
+      if (size(fields(i)%v, 1) < 1 .or. size(fields(i)%v, 2) /= n) then
+        call fatal_error(err, 'write_vtu: '//trim(path)//': '//kind_name//' field "' &
+                         //fields(i)%name//'" has shape ('//itoa(size(fields(i)%v, 1))//',' &
+                         //itoa(size(fields(i)%v, 2))//'), expected (ncomp>=1,'//itoa(n)//')')
+        return
+      end if
+    end do
+  end subroutine check_fields
+
+  !> One <DataArray .../> line for appended data at offset; advances offset past this
+  !> array's block (8-byte length header + nbytes of values).
+  function data_array(vtk_type, name, ncomp, offset, nbytes) result(s)
+    character(len=*), intent(in) :: vtk_type, name
+    integer, intent(in) :: ncomp
+    integer(int64), intent(inout) :: offset
+    integer(int64), intent(in) :: nbytes
+    character(len=:), allocatable :: s
+    s = '        <DataArray type="'//vtk_type//'" Name="'//xml_escape(name) &
+        //'" NumberOfComponents="'//itoa(ncomp)//'" format="appended" offset="' &
+        //itoa(offset)//'"/>'//nl
+    offset = offset + 8_int64 + nbytes
+  end function data_array
+
+  !> The UInt64 length header of an appended block of n values of bytes_per_value each.
+  pure function nbytes(bytes_per_value, n) result(b)
+    integer, intent(in) :: bytes_per_value
+    integer(int64), intent(in) :: n
+    integer(int64) :: b
+    b = int(bytes_per_value, int64)*n
+  end function nbytes
+
+  !> Byte order of this machine, for the byte_order attribute (raw data is written natively).
+  pure function byte_order() result(s)
+    character(len=:), allocatable :: s
+    integer(int8) :: bytes(4)
+    bytes = transfer(1_int32, bytes)
+    if (bytes(1) == 1_int8) then
+      s = 'LittleEndian'
+    else
+      s = 'BigEndian'
+    end if
+  end function byte_order
+
+  !> Escape the characters that would break an XML attribute value.
+  pure function xml_escape(s) result(r)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: r
+    integer :: i
+    r = ''
+    do i = 1, len(s)
+      select case (s(i:i))
+      case ('&')
+        r = r//'&amp;'
+      case ('<')
+        r = r//'&lt;'
+      case ('>')
+        r = r//'&gt;'
+      case ('"')
+        r = r//'&quot;'
+      case default
+        r = r//s(i:i)
+      end select
+    end do
+  end function xml_escape
+
+  pure function itoa_i32(i) result(s)
+    integer(int32), intent(in) :: i
+    character(len=:), allocatable :: s
+    s = itoa_i64(int(i, int64))
+  end function itoa_i32
+
+  pure function itoa_i64(i) result(s)
+    integer(int64), intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=24) :: buf
+    write (buf, '(i0)') i
+    s = trim(buf)
+  end function itoa_i64
+end module casca_vtu_writer

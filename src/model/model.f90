@@ -1,0 +1,162 @@
+!> A scene as the solver sees it: all bodies' nodes and elements in one numbering, materials,
+!> element reference data (A0^-1, w det A0, mass), prescribed parameters and dead loads.
+!> Parameters of node i are dofs 7(i-1)+1..7(i-1)+7 = [Y(3), G(3), A].
+module casca_model
+  use casca_kinds, only: dp
+  use casca_error, only: error_t, fatal_error
+  use casca_mesh, only: mesh_t, nen
+  use casca_shape_tri10, only: tri10_shape, tri10_node_xi
+  use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, shell_mass, &
+                                 svk_lame, ndof_node
+  implicit none
+  private
+  public :: body_t, model_t, model_add_body, model_finalize, dof, reference_state
+  public :: area_points, thick_points
+
+  integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
+  integer, parameter :: thick_points = 3
+
+  type :: body_t
+    character(len=:), allocatable :: name
+    real(dp) :: young = 0, poisson = 0, density = 0, thickness = 0, lam = 0, mu = 0
+    integer :: node_first = 0, node_last = -1, elem_first = 0, elem_last = -1
+  end type body_t
+
+  type :: model_t
+    integer :: nnode = 0, nelem = 0, ndof = 0, nbody = 0
+    type(body_t), allocatable :: body(:)
+    real(dp), allocatable :: x0(:, :)        !< (3, nnode) initial mid-surface
+    real(dp), allocatable :: v0(:, :)        !< (3, nnode) initial unit fibre (normal)
+    logical, allocatable :: exact_normal(:)  !< (nnode) normal given by the generator
+    integer, allocatable :: conn(:, :)       !< (nen, nelem)
+    integer, allocatable :: elem_body(:), node_body(:)
+    type(shell_rule_t) :: rule               !< stiffness rule
+    real(dp), allocatable :: binv(:, :, :, :), wdet(:, :)   !< (3,3,np,nelem), (np,nelem)
+    real(dp), allocatable :: emass(:, :, :)  !< (20, 20, nelem) scalar element mass
+    logical, allocatable :: fixed(:)         !< (ndof) prescribed parameters
+    real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
+    real(dp) :: gravity(3) = 0
+    real(dp) :: length = 1                   !< size of the scene (bounding-box diagonal)
+  end type model_t
+
+contains
+
+  elemental integer function dof(node, comp)
+    integer, intent(in) :: node, comp
+    dof = ndof_node*(node - 1) + comp
+  end function dof
+
+  !> Append a body (mesh and material) to the model.
+  subroutine model_add_body(model, name, mesh, young, poisson, density, thickness)
+    type(model_t), intent(inout) :: model
+    character(len=*), intent(in) :: name
+    type(mesh_t), intent(in) :: mesh
+    real(dp), intent(in) :: young, poisson, density, thickness
+    type(body_t), allocatable :: bodies(:)
+    real(dp), allocatable :: x(:, :), v(:, :)
+    logical, allocatable :: ex(:)
+    integer, allocatable :: conn(:, :), eb(:), nb(:)
+    type(body_t) :: b
+    integer :: nn, ne
+
+    nn = model%nnode; ne = model%nelem
+    b%name = name
+    b%young = young; b%poisson = poisson; b%density = density; b%thickness = thickness
+    call svk_lame(young, poisson, b%lam, b%mu)
+    b%node_first = nn + 1; b%node_last = nn + mesh%nnode
+    b%elem_first = ne + 1; b%elem_last = ne + mesh%nelem
+    if (model%nbody == 0) then
+      allocate (model%body(0), model%x0(3, 0), model%v0(3, 0), model%exact_normal(0), &
+                model%conn(nen, 0), model%elem_body(0), model%node_body(0))
+    end if
+    bodies = [model%body, b]
+    call move_alloc(bodies, model%body)
+    allocate (x(3, nn + mesh%nnode), v(3, nn + mesh%nnode), ex(nn + mesh%nnode))
+    x(:, 1:nn) = model%x0; x(:, nn + 1:) = mesh%x
+    v = 0; v(:, 1:nn) = model%v0
+    ex(1:nn) = model%exact_normal
+    ex(nn + 1:) = size(mesh%normal, 2) == mesh%nnode
+    if (ex(nn + 1)) v(:, nn + 1:) = mesh%normal
+    call move_alloc(x, model%x0); call move_alloc(v, model%v0); call move_alloc(ex, model%exact_normal)
+    allocate (conn(nen, ne + mesh%nelem))
+    conn(:, 1:ne) = model%conn; conn(:, ne + 1:) = mesh%conn + nn
+    call move_alloc(conn, model%conn)
+    eb = [model%elem_body, spread(model%nbody + 1, 1, mesh%nelem)]
+    nb = [model%node_body, spread(model%nbody + 1, 1, mesh%nnode)]
+    call move_alloc(eb, model%elem_body); call move_alloc(nb, model%node_body)
+    model%nbody = model%nbody + 1
+    model%nnode = nn + mesh%nnode; model%nelem = ne + mesh%nelem
+  end subroutine model_add_body
+
+  !> Normals, element reference data and masses; arrays for restraints and loads.
+  subroutine model_finalize(model, err)
+    type(model_t), intent(inout) :: model
+    type(error_t), allocatable, intent(out) :: err
+    type(shell_rule_t) :: mrule
+    real(dp) :: phi(10), dphi(10, 2), t1(3), t2(3), detmin, h
+    integer :: e, l, i
+    character(len=200) :: msg
+
+    model%ndof = ndof_node*model%nnode
+    call shell_rule_init(area_points, thick_points, model%rule, err)
+    if (allocated(err)) return
+    call shell_rule_init(12, 3, mrule, err)   ! degree 6 in-plane: exact mass of flat elements
+    if (allocated(err)) return
+
+    ! averaged normals where the generator gave none [formulation.md choice]
+    do e = 1, model%nelem
+      do l = 1, nen
+        i = model%conn(l, e)
+        if (model%exact_normal(i)) cycle
+        call tri10_shape(tri10_node_xi(1, l), tri10_node_xi(2, l), phi, dphi)
+        t1 = matmul(model%x0(:, model%conn(:, e)), dphi(:, 1))
+        t2 = matmul(model%x0(:, model%conn(:, e)), dphi(:, 2))
+        model%v0(:, i) = model%v0(:, i) + cross(t1, t2)
+      end do
+    end do
+    do i = 1, model%nnode
+      if (norm2(model%v0(:, i)) <= 0) then
+        write (msg, '(a,i0,a)') 'node ', i, ' has no normal (degenerate elements around it)'
+        call fatal_error(err, trim(msg)); return
+      end if
+      model%v0(:, i) = model%v0(:, i)/norm2(model%v0(:, i))
+    end do
+
+    allocate (model%binv(3, 3, model%rule%np, model%nelem), model%wdet(model%rule%np, model%nelem))
+    allocate (model%emass(20, 20, model%nelem))
+    do e = 1, model%nelem
+      h = model%body(model%elem_body(e))%thickness
+      call shell_reference(model%rule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
+                           h, model%binv(:, :, :, e), model%wdet(:, e), detmin)
+      if (detmin <= 0) then
+        write (msg, '(a,i0,a,a,a)') 'element ', e - model%body(model%elem_body(e))%elem_first + 1, &
+          ' of body "', model%body(model%elem_body(e))%name, &
+          '" is degenerate or inverted (det A0 <= 0 at a quadrature point)'
+        call fatal_error(err, trim(msg)); return
+      end if
+      call shell_mass(mrule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), h, &
+                      model%body(model%elem_body(e))%density, model%emass(:, :, e))
+    end do
+    allocate (model%fixed(model%ndof), model%fext(model%ndof))
+    model%fixed = .false.; model%fext = 0
+    model%length = norm2(maxval(model%x0, dim=2) - minval(model%x0, dim=2))
+  end subroutine model_finalize
+
+  !> q of the unstressed initial state: Y = X, G = V, A = 0.
+  pure subroutine reference_state(model, q)
+    type(model_t), intent(in) :: model
+    real(dp), intent(out) :: q(:)
+    integer :: i
+    do i = 1, model%nnode
+      q(dof(i, 1):dof(i, 3)) = model%x0(:, i)
+      q(dof(i, 4):dof(i, 6)) = model%v0(:, i)
+      q(dof(i, 7)) = 0
+    end do
+  end subroutine reference_state
+
+  pure function cross(a, b) result(c)
+    real(dp), intent(in) :: a(3), b(3)
+    real(dp) :: c(3)
+    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+  end function cross
+end module casca_model

@@ -1,0 +1,147 @@
+!> Sparse symmetric (indefinite) solver: MUMPS with the matrix distributed over the ranks as
+!> assembled entries (ICNTL(18) = 3), right-hand side and solution centralised on rank 0.
+!> The analysis is kept while the sparsity pattern does not change; each Newton iteration only
+!> refactorises (JOB = 2) and solves (JOB = 3).
+module casca_mumps_solver
+  use casca_kinds, only: dp
+  use casca_error, only: error_t, fatal_error
+  use casca_mpi, only: comm_handle, is_root, bcast_real
+  implicit none
+  private
+  public :: sparse_solver_t
+
+  include 'dmumps_struc.h'
+
+  type :: sparse_solver_t
+    type(dmumps_struc), private :: id
+    logical :: started = .false.
+    logical :: analysed = .false.
+    !> ICNTL(7): 7 = MUMPS chooses (PORD here), 1 = METIS nested dissection given by casca;
+    !> equal within 3% on the 720-element sphere (docs/performance.md), so MUMPS chooses
+    integer :: ordering = 7
+  contains
+    procedure :: init => solver_init
+    procedure :: analyse => solver_analyse
+    procedure :: factorise => solver_factorise
+    procedure :: solve => solver_solve
+    procedure :: negative_pivots => solver_negative_pivots
+    procedure :: finish => solver_finish
+  end type sparse_solver_t
+
+contains
+
+  subroutine solver_init(self)
+    class(sparse_solver_t), intent(inout) :: self
+    if (self%started) return
+    self%id%comm = comm_handle()
+    self%id%sym = 2    ! symmetric, possibly indefinite (saddle points of contact)
+    self%id%par = 1    ! the host works too
+    self%id%job = -1
+    call dmumps(self%id)
+    ! ICNTL only after JOB = -1
+    self%id%icntl(1) = -1; self%id%icntl(2) = -1; self%id%icntl(3) = -1; self%id%icntl(4) = 0
+    self%id%icntl(18) = 3             ! distributed assembled matrix
+    self%id%icntl(7) = self%ordering
+    self%id%icntl(14) = 40            ! workspace margin (percent)
+    self%id%icntl(13) = 1             ! no ScaLAPACK root: cheaper for our small fronts
+    self%id%icntl(24) = 0
+    self%started = .true.
+  end subroutine solver_init
+
+  !> Symbolic analysis of the pattern irn(k) >= jcn(k) (this rank's entries; duplicates sum).
+  !> perm: pivot order (rank 0), used when ordering = 1.
+  subroutine solver_analyse(self, n, irn, jcn, perm, err)
+    class(sparse_solver_t), intent(inout) :: self
+    integer, intent(in) :: n, irn(:), jcn(:), perm(:)
+    type(error_t), allocatable, intent(out) :: err
+    call self%init()
+    if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
+    self%id%n = n
+    self%id%nnz_loc = size(irn, kind=8)
+    allocate (self%id%irn_loc(size(irn)), self%id%jcn_loc(size(irn)), self%id%a_loc(size(irn)))
+    self%id%irn_loc = irn
+    self%id%jcn_loc = jcn
+    self%id%a_loc = 0
+    if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
+    self%id%icntl(7) = self%ordering
+    if (self%ordering == 1 .and. is_root()) then
+      allocate (self%id%perm_in(n))
+      self%id%perm_in = perm
+    end if
+    self%id%job = 1
+    call dmumps(self%id)
+    call check(self, 'analysis', err)
+    self%analysed = .not. allocated(err)
+  end subroutine solver_analyse
+
+  !> Numerical factorisation of this rank's values (same order as the analysed pattern).
+  subroutine solver_factorise(self, a, err)
+    class(sparse_solver_t), intent(inout) :: self
+    real(dp), intent(in) :: a(:)
+    type(error_t), allocatable, intent(out) :: err
+    integer :: attempt
+    self%id%a_loc = a
+    do attempt = 1, 4
+      self%id%job = 2
+      call dmumps(self%id)
+      ! -8, -9: workspace too small (more pivoting than the analysis forecast): grow and retry
+      if (self%id%infog(1) /= -8 .and. self%id%infog(1) /= -9) exit
+      self%id%icntl(14) = 2*self%id%icntl(14)
+    end do
+    call check(self, 'factorisation', err)
+  end subroutine solver_factorise
+
+  !> x = K^-1 b; b needed on rank 0 only, x returned on every rank.
+  subroutine solver_solve(self, b, x, err)
+    class(sparse_solver_t), intent(inout) :: self
+    real(dp), intent(in) :: b(:)
+    real(dp), intent(out) :: x(:)
+    type(error_t), allocatable, intent(out) :: err
+    if (is_root()) then
+      if (associated(self%id%rhs)) then
+        if (size(self%id%rhs) /= size(b)) deallocate (self%id%rhs)
+      end if
+      if (.not. associated(self%id%rhs)) allocate (self%id%rhs(size(b)))
+      self%id%rhs = b
+    end if
+    self%id%job = 3
+    call dmumps(self%id)
+    call check(self, 'solution', err)
+    if (allocated(err)) return
+    if (is_root()) x = self%id%rhs
+    call bcast_real(x)
+  end subroutine solver_solve
+
+  !> Negative pivots of the last factorisation (the inertia of a saddle-point matrix).
+  integer function solver_negative_pivots(self)
+    class(sparse_solver_t), intent(in) :: self
+    solver_negative_pivots = self%id%infog(12)
+  end function solver_negative_pivots
+
+  subroutine solver_finish(self)
+    class(sparse_solver_t), intent(inout) :: self
+    if (.not. self%started) return
+    if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
+    if (associated(self%id%rhs)) deallocate (self%id%rhs)
+    if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
+    self%id%job = -2
+    call dmumps(self%id)
+    self%started = .false.; self%analysed = .false.
+  end subroutine solver_finish
+
+  subroutine check(self, what, err)
+    class(sparse_solver_t), intent(in) :: self
+    character(len=*), intent(in) :: what
+    type(error_t), allocatable, intent(out) :: err
+    character(len=160) :: msg
+    if (self%id%infog(1) >= 0) return
+    select case (self%id%infog(1))
+    case (-10)
+      msg = 'the tangent matrix is singular (a body is not restrained or a load is unstable)'
+    case default
+      write (msg, '(a,i0,a,i0)') 'MUMPS error INFOG(1) = ', self%id%infog(1), &
+        ', INFOG(2) = ', self%id%infog(2)
+    end select
+    call fatal_error(err, 'linear solver '//what//': '//trim(msg))
+  end subroutine check
+end module casca_mumps_solver
