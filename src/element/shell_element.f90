@@ -16,7 +16,7 @@ module casca_shell_element
   implicit none
   private
   public :: shell_rule_t, shell_rule_init, shell_reference, shell_energy_force, shell_mass
-  public :: ndof_node, ndof_elem, svk_lame
+  public :: ndof_node, ndof_elem, svk_lame, shell_von_mises
 
   integer, parameter :: ndof_node = 7
   integer, parameter :: ndof_elem = 70
@@ -264,6 +264,44 @@ contains
       end if
     end function vidx
   end subroutine shell_energy_force
+
+  !> Von Mises stress of the Cauchy stress at (xi1, xi2) on the mid-surface (xi3 = 0), for
+  !> output: sigma = F S F^T / det F with F = A1 A0^-1.
+  pure real(dp) function shell_von_mises(x0, v0, h, lam, mu, q, xi1, xi2) result(vm)
+    real(dp), intent(in) :: x0(3, 10), v0(3, 10), h, lam, mu, q(7, 10), xi1, xi2
+    real(dp) :: phi(10), dphi(10, 2), a0(3, 3), a1(3, 3), f(3, 3), e(3, 3), s(3, 3), sig(3, 3)
+    real(dp) :: inv(3, 3), d, g(3)
+    integer :: i
+    call tri10_shape(xi1, xi2, phi, dphi)
+    a0 = initial_jacobian(phi, dphi, x0, v0, h, 0._dp)
+    g = matmul(q(4:6, :), phi)
+    a1(:, 1) = matmul(q(1:3, :), dphi(:, 1))
+    a1(:, 2) = matmul(q(1:3, :), dphi(:, 2))
+    a1(:, 3) = 0.5_dp*h*g          ! at xi3 = 0 the thickness parameter only enters d/dxi3
+    d = det3(a0)
+    inv(:, 1) = cross3(a0(:, 2), a0(:, 3))/d   ! rows of A0^-1, stored as columns
+    inv(:, 2) = cross3(a0(:, 3), a0(:, 1))/d
+    inv(:, 3) = cross3(a0(:, 1), a0(:, 2))/d
+    f = matmul(a1, transpose(inv))
+    e = 0.5_dp*matmul(transpose(f), f)
+    do i = 1, 3
+      e(i, i) = e(i, i) - 0.5_dp
+    end do
+    s = 2*mu*e
+    do i = 1, 3
+      s(i, i) = s(i, i) + lam*(e(1, 1) + e(2, 2) + e(3, 3))
+    end do
+    sig = matmul(f, matmul(s, transpose(f)))/det3(f)
+    vm = sqrt(0.5_dp*((sig(1, 1) - sig(2, 2))**2 + (sig(2, 2) - sig(3, 3))**2 &
+                      + (sig(3, 3) - sig(1, 1))**2) &
+              + 3*(sig(1, 2)**2 + sig(2, 3)**2 + sig(1, 3)**2))
+  end function shell_von_mises
+
+  pure function cross3(a, b) result(c)
+    real(dp), intent(in) :: a(3), b(3)
+    real(dp) :: c(3)
+    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+  end function cross3
 
   !> Constant consistent mass of one element from the part of the map linear in (Y, G):
   !> y_K = phi_l Y^l + h/2 xi3 phi_l G^l. m(p, q) is the scalar mass between vector

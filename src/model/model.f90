@@ -10,7 +10,7 @@ module casca_model
                                  svk_lame, ndof_node
   implicit none
   private
-  public :: body_t, model_t, model_add_body, model_finalize, dof, reference_state
+  public :: body_t, model_t, model_add_body, model_finalize, dof, element_dofs, reference_state
   public :: area_points, thick_points
 
   integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
@@ -45,6 +45,19 @@ contains
     integer, intent(in) :: node, comp
     dof = ndof_node*(node - 1) + comp
   end function dof
+
+  !> The 70 dofs of element e in the element order 7(l-1)+c.
+  pure function element_dofs(model, e) result(d)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: e
+    integer :: d(7*nen)
+    integer :: l, c
+    do l = 1, nen
+      do c = 1, ndof_node
+        d(ndof_node*(l - 1) + c) = dof(model%conn(l, e), c)
+      end do
+    end do
+  end function element_dofs
 
   !> Append a body (mesh and material) to the model.
   subroutine model_add_body(model, name, mesh, young, poisson, density, thickness)

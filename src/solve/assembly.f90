@@ -5,13 +5,13 @@
 module casca_assembly
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_model, only: model_t, dof
+  use casca_model, only: model_t, element_dofs
   use casca_shell_element, only: shell_energy_force, ndof_elem
   use casca_mpi, only: my_rank, n_ranks, sum_all, bcast_int, is_root
   use casca_metis, only: partition_elements
   implicit none
   private
-  public :: assembly_t, assembly_setup, assemble, element_dofs
+  public :: assembly_t, assembly_setup, assemble
 
   type :: assembly_t
     integer :: neq = 0
@@ -24,18 +24,6 @@ module casca_assembly
   end type assembly_t
 
 contains
-
-  pure function element_dofs(model, e) result(d)
-    type(model_t), intent(in) :: model
-    integer, intent(in) :: e
-    integer :: d(ndof_elem)
-    integer :: l, c
-    do l = 1, 10
-      do c = 1, 7
-        d(7*(l - 1) + c) = dof(model%conn(l, e), c)
-      end do
-    end do
-  end function element_dofs
 
   !> Equation numbering of the free parameters, the element partition (METIS, computed on
   !> rank 0 and broadcast so that every rank agrees) and this rank's entry pattern.

@@ -1,0 +1,262 @@
+!> The commands that work on a deck: `check` (read, sanity, build) and `run` (the time loop:
+!> step, account, write). Exit codes: 0 done, 2 bad input, 3 the solver could not go on.
+module casca_run
+  use casca_kinds, only: dp
+  use casca_error, only: error_t
+  use casca_deck, only: deck_t, read_deck, unset
+  use casca_sanity, only: check_deck
+  use casca_scene, only: build_model, initial_state, tracked_nodes
+  use casca_model, only: model_t, reference_state
+  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_mumps_solver, only: sparse_solver_t
+  use casca_newton, only: newton_opts_t, newton_report_t
+  use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
+  use casca_accounting, only: balance_t, account, gravity_load
+  use casca_output, only: output_t, output_open, output_history, output_frame, output_close
+  use casca_vtu_writer, only: field_t
+  use casca_hdf5_io, only: write_checkpoint, read_checkpoint
+  use casca_plots, only: make_plots
+  use casca_mpi, only: is_root, wall_time, n_ranks
+  implicit none
+  private
+  public :: load_scene, run_deck
+
+  integer, parameter, public :: exit_ok = 0, exit_input = 2, exit_solver = 3
+
+contains
+
+  !> Read, check and build; print every problem on rank 0. code = exit_input on problems.
+  subroutine load_scene(path, deck, model, code)
+    character(len=*), intent(in) :: path
+    type(deck_t), intent(out) :: deck
+    type(model_t), intent(out) :: model
+    integer, intent(out) :: code
+    integer :: i
+    call read_deck(path, deck)
+    if (deck%nproblems == 0) call check_deck(deck)
+    if (deck%nproblems == 0) call build_model(deck, model)
+    code = exit_ok
+    if (deck%nproblems > 0) then
+      if (is_root()) then
+        do i = 1, deck%nproblems
+          write (0, '(a,a)') 'error: ', trim(deck%problems(i))
+        end do
+        write (0, '(i0,a)') deck%nproblems, ' problem(s) in the deck; nothing was run'
+      end if
+      code = exit_input
+    end if
+  end subroutine load_scene
+
+  subroutine run_deck(path, out_dir, restart, quiet, code)
+    character(len=*), intent(in) :: path, out_dir, restart
+    logical, intent(in) :: quiet
+    integer, intent(out) :: code
+    type(deck_t) :: deck
+    type(model_t) :: model
+    type(assembly_t) :: asm
+    type(sparse_solver_t) :: solver
+    type(newton_opts_t) :: opts
+    type(newton_report_t) :: rep
+    type(state_t) :: st
+    type(newmark_t) :: nm
+    type(balance_t) :: bal
+    type(output_t) :: out
+    type(error_t), allocatable :: err
+    real(dp), allocatable :: fext(:), fgrav(:), q0(:)
+    integer, allocatable :: tracked(:), ints(:)
+    character(len=128), allocatable :: labels(:)
+    character(len=:), allocatable :: dir
+    real(dp) :: interval, next_frame, next_ckpt, t0, t_start, dt
+    integer :: level, k, restart_step, total_newton
+    logical :: missing
+
+    code = exit_ok
+    call load_scene(path, deck, model, code)
+    if (code /= exit_ok) return
+    dir = trim(deck%output%dir)
+    if (out_dir /= '') dir = trim(out_dir)
+
+    call assembly_setup(model, asm, err)
+    if (failed('setup')) return
+    if (deck%run%ordering == 'metis') solver%ordering = 1
+    opts%tol = deck%run%newton_tol; opts%max_iter = deck%run%newton_max_iter
+    allocate (fgrav(model%ndof))
+    call gravity_load(model, fgrav)
+    fext = model%fext + fgrav
+    call tracked_nodes(deck, model, tracked)
+    allocate (labels(size(tracked)))
+    do k = 1, size(tracked)
+      write (labels(k), '(a,a,i0,a,3(g0.4,:,", "))') trim(model%body(model%node_body(tracked(k)))%name), &
+        ' node ', tracked(k) - model%body(model%node_body(tracked(k)))%node_first + 1, &
+        ' near (', deck%output%track(:, k)
+      labels(k) = trim(labels(k))//')'
+    end do
+    call initial_state(deck, model, st)
+    allocate (q0(model%ndof))
+    call reference_state(model, q0)
+
+    level = 0; restart_step = -1
+    if (restart /= '') then
+      call read_checkpoint(restart, st%t, st%step, st%q, st%qd, st%qdd, ints, err)
+      if (allocated(err)) then
+        if (is_root()) write (0, '(a,a)') 'error: ', err%message
+        code = exit_input; return
+      end if
+      if (size(st%q) /= model%ndof) then
+        if (is_root()) write (0, '(a)') 'error: '//trim(restart)// &
+          ': the checkpoint does not belong to this deck (different number of parameters)'
+        code = exit_input; return
+      end if
+      if (size(ints) >= 1) level = ints(1)
+      restart_step = st%step
+    end if
+    call output_open(out, dir, tracked, labels, restart_step, st%t, err)
+    if (failed('output')) return
+
+    t0 = wall_time(); t_start = st%t
+    if (deck%run%analysis == 'static') then
+      call static_run()
+      return
+    end if
+
+    nm%beta = deck%run%beta; nm%gamma = deck%run%gamma
+    dt = deck%run%dt
+    interval = deck%output%interval
+    if (interval == unset) interval = deck%run%t_end/100
+    interval = max(interval, dt)
+    next_frame = (floor(st%t/interval + 1e-9_dp) + 1)*interval
+    next_ckpt = huge(1._dp)
+    if (deck%output%checkpoint_interval > 0) &
+      next_ckpt = (floor(st%t/deck%output%checkpoint_interval + 1e-9_dp) + 1)*deck%output%checkpoint_interval
+    if (restart_step < 0) then
+      call account(model, asm, st, fext, q0, bal)
+      call output_history(out, st, bal, 0, 0._dp, 0, err)
+      if (failed('history')) return
+      if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], err)
+      if (failed('frame')) return
+    end if
+    if (is_root() .and. .not. quiet) print '(a,i0,a,i0,a,i0,a,i0,a)', 'casca: ', model%nbody, &
+      ' bodies, ', model%nelem, ' elements, ', asm%neq, ' unknowns, ', n_ranks, ' rank(s)'
+
+    total_newton = 0
+    do while (st%t < deck%run%t_end - 1e-9_dp*dt)
+      nm%dt = min(dt/2**level, deck%run%t_end - st%t)
+      call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err)
+      if (allocated(err)) then
+        if (level < deck%run%max_step_cuts) then
+          level = level + 1   ! the state is unchanged: retry with half the step
+          if (is_root() .and. .not. quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
+            dt/2**level, ': ', err%message
+          deallocate (err)
+          cycle
+        end if
+        call give_up(err%message)
+        return
+      end if
+      total_newton = total_newton + rep%iters
+      if (level > 0 .and. rep%iters <= 3) level = level - 1   ! Newton is at ease: grow back
+      call account(model, asm, st, fext, q0, bal)
+      call output_history(out, st, bal, 0, 0._dp, rep%iters, err)
+      if (failed('history')) return
+      if (st%t >= next_frame - 1e-9_dp*dt .or. st%t >= deck%run%t_end - 1e-9_dp*dt) then
+        if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], err)
+        if (failed('frame')) return
+        next_frame = next_frame + interval
+        if (is_root() .and. .not. quiet) call progress()
+      end if
+      if (st%t >= next_ckpt - 1e-9_dp*dt) then
+        call checkpoint()
+        if (code /= exit_ok) return
+        next_ckpt = next_ckpt + deck%output%checkpoint_interval
+      end if
+    end do
+    call checkpoint()
+    if (code /= exit_ok) return
+    call finish()
+
+  contains
+
+    logical function failed(what)
+      character(len=*), intent(in) :: what
+      failed = allocated(err)
+      if (failed) then
+        if (is_root()) write (0, '(a,a,a,a)') 'error (', what, '): ', err%message
+        code = exit_solver
+        if (what == 'output' .or. what == 'setup') code = exit_input
+      end if
+    end function failed
+
+    subroutine progress()
+      real(dp) :: el
+      el = wall_time() - t0
+      print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
+        '  dt', nm%dt, '  newton/step', real(total_newton)/max(st%step - max(restart_step, 0), 1), &
+        '  contacts', 0, '  elapsed', el, ' s  left', &
+        el*max(deck%run%t_end - st%t, 0._dp)/max(st%t - t_start, tiny(1._dp)), ' s'
+    end subroutine progress
+
+    subroutine checkpoint()
+      type(error_t), allocatable :: e
+      if (.not. is_root()) return
+      call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, [level], e)
+      if (allocated(e)) then
+        write (0, '(a,a)') 'error (checkpoint): ', e%message
+        code = exit_solver
+      end if
+    end subroutine checkpoint
+
+    !> The solver cannot go on: keep the last good state (frame and checkpoint) and stop.
+    subroutine give_up(why)
+      character(len=*), intent(in) :: why
+      type(error_t), allocatable :: e
+      if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', st%t, &
+        ' s: ', why
+      if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], e)
+      call checkpoint()
+      call output_close(out, e)
+      if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
+        '/checkpoint.h5 (restart with --restart) and in the last frame of '//dir//'/run.pvd'
+      code = exit_solver
+    end subroutine give_up
+
+    subroutine finish()
+      type(error_t), allocatable :: e
+      call output_close(out, e)
+      if (allocated(e)) then
+        if (is_root()) write (0, '(a,a)') 'error (output): ', e%message
+        code = exit_solver; return
+      end if
+      if (deck%output%plots .and. is_root()) then
+        call make_plots(dir, e, missing)
+        if (allocated(e)) write (0, '(a,a)') 'warning: plots: ', e%message
+        if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//dir// &
+          '/plots.gp was written but not run'
+      end if
+      if (is_root() .and. .not. quiet) print '(a,i0,a,f0.2,a,a)', 'done: ', st%step, &
+        ' steps in ', wall_time() - t0, ' s; results in ', dir
+    end subroutine finish
+
+    !> Statics: load steps of the dead loads; one history row and frame per load step
+    !> (t = load factor).
+    subroutine static_run()
+      integer :: i
+      do i = 1, deck%run%load_steps
+        call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
+                          opts, st%q, rep, err)
+        if (allocated(err)) then
+          call give_up(err%message); return
+        end if
+        st%t = real(i, dp)/deck%run%load_steps; st%step = i
+        call account(model, asm, st, fext*st%t, q0, bal)
+        call output_history(out, st, bal, 0, 0._dp, rep%iters, err)
+        if (failed('history')) return
+        if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], err)
+        if (failed('frame')) return
+        if (is_root() .and. .not. quiet) print '(a,i4,a,f6.3,a,i3)', 'load step', i, &
+          '  factor', st%t, '  newton', rep%iters
+      end do
+      call checkpoint()
+      call finish()
+    end subroutine static_run
+  end subroutine run_deck
+end module casca_run

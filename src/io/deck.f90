@@ -1,0 +1,387 @@
+!> The input deck: a Fortran namelist file with the groups
+!>   &run        analysis, time step, end time, Newmark and Newton parameters, gravity
+!>   &output     folder, frame interval, tracked points, checkpoint interval
+!>   &body       (one per body) mesh or generator, material, thickness, initial motion
+!>   &restraint  (any number) prescribed parameters of the nodes of a body inside a box
+!>   &load       (any number) a dead force shared by the nodes of a body inside a box
+!>   &contact    contact pairs and tolerances
+!> Every problem found while reading is collected (file:line: group: message) so that the
+!> user sees them all at once; nothing here stops the program.
+module casca_deck
+  use, intrinsic :: iso_fortran_env, only: iostat_end
+  use casca_kinds, only: dp
+  implicit none
+  private
+  public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
+  public :: contact_cfg_t, read_deck, add_problem, max_track, unset
+
+  integer, parameter :: max_track = 16
+  integer, parameter :: max_pairs = 64
+  real(dp), parameter :: unset = -huge(1._dp)   !< marks a value the deck did not give
+  character(len=*), parameter :: known_groups(7) = &
+    [character(len=9) :: 'run', 'output', 'body', 'restraint', 'load', 'contact', 'end']
+
+  type :: run_cfg_t
+    character(len=128) :: title = ''
+    character(len=16) :: analysis = 'dynamic'   !< 'dynamic' or 'static'
+    real(dp) :: dt = unset, t_end = unset
+    real(dp) :: beta = 1.0_dp, gamma = 1.5_dp  !< the thesis' choice for impact
+    real(dp) :: newton_tol = 1e-9_dp
+    integer :: newton_max_iter = 20
+    integer :: load_steps = 10
+    integer :: max_step_cuts = 4
+    real(dp) :: gravity(3) = 0
+    character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
+  end type run_cfg_t
+
+  type :: output_cfg_t
+    character(len=256) :: dir = 'out'
+    real(dp) :: interval = unset                !< time between VTU frames (default t_end/100)
+    logical :: vtu = .true.
+    logical :: plots = .true.
+    real(dp) :: checkpoint_interval = 0         !< 0: checkpoint at the end only
+    integer :: ntrack = 0
+    real(dp) :: track(3, max_track) = 0         !< tracked nodes: nearest to these points
+    character(len=64) :: track_body(max_track) = ''
+  end type output_cfg_t
+
+  type :: body_cfg_t
+    character(len=64) :: name = ''
+    character(len=16) :: mesh = ''              !< ring, sphere, plate, strip, file
+    character(len=256) :: file = ''
+    real(dp) :: radius = 1, width = 0.2_dp, lx = 1, ly = 1
+    integer :: n_around = 20, n_across = 1, n_div = 6, nx = 4, ny = 1
+    real(dp) :: center(3) = 0                   !< the generated or read mesh is moved here
+    real(dp) :: young = unset, poisson = 0.3_dp, density = unset, thickness = unset
+    real(dp) :: velocity(3) = 0, omega(3) = 0   !< omega about the body's centroid
+    integer :: line = 0
+  end type body_cfg_t
+
+  type :: restraint_cfg_t
+    character(len=64) :: body = ''
+    real(dp) :: box_min(3) = -huge(1._dp), box_max(3) = huge(1._dp)
+    character(len=64) :: fix = 'clamped'
+    integer :: line = 0
+  end type restraint_cfg_t
+
+  type :: load_cfg_t
+    character(len=64) :: body = ''
+    real(dp) :: box_min(3) = -huge(1._dp), box_max(3) = huge(1._dp)
+    real(dp) :: force(3) = 0                    !< total, shared equally by the nodes
+    integer :: line = 0
+  end type load_cfg_t
+
+  type :: contact_cfg_t
+    logical :: enabled = .true.
+    integer :: npairs = 0                       !< 0: every pair of bodies
+    character(len=64) :: pairs(2, max_pairs) = ''
+    real(dp) :: tolerance = 1e-7_dp             !< penetration accepted, relative to scene size
+    integer :: line = 0
+  end type contact_cfg_t
+
+  type :: deck_t
+    character(len=:), allocatable :: path
+    character(len=:), allocatable :: base_dir   !< folder of the deck: mesh files are relative to it
+    type(run_cfg_t) :: run
+    type(output_cfg_t) :: output
+    type(body_cfg_t), allocatable :: bodies(:)
+    type(restraint_cfg_t), allocatable :: restraints(:)
+    type(load_cfg_t), allocatable :: loads(:)
+    type(contact_cfg_t) :: contact
+    integer :: nproblems = 0
+    character(len=512), allocatable :: problems(:)
+  end type deck_t
+
+contains
+
+  subroutine add_problem(deck, line, msg)
+    type(deck_t), intent(inout) :: deck
+    integer, intent(in) :: line
+    character(len=*), intent(in) :: msg
+    character(len=512), allocatable :: tmp(:)
+    character(len=16) :: ls
+    if (.not. allocated(deck%problems)) allocate (deck%problems(16))
+    if (deck%nproblems == size(deck%problems)) then
+      allocate (tmp(2*size(deck%problems)))
+      tmp(1:deck%nproblems) = deck%problems(1:deck%nproblems)
+      call move_alloc(tmp, deck%problems)
+    end if
+    deck%nproblems = deck%nproblems + 1
+    if (line > 0) then
+      write (ls, '(i0)') line
+      deck%problems(deck%nproblems) = deck%path//':'//trim(ls)//': '//msg
+    else
+      deck%problems(deck%nproblems) = deck%path//': '//msg
+    end if
+  end subroutine add_problem
+
+  !> Read every group of the deck at path. Problems go to deck%problems.
+  subroutine read_deck(path, deck)
+    character(len=*), intent(in) :: path
+    type(deck_t), intent(out) :: deck
+    integer :: u, ios, k
+    character(len=256) :: msg
+    integer, allocatable :: gline(:)
+    character(len=16), allocatable :: gname(:)
+
+    deck%path = path
+    k = index(path, '/', back=.true.)
+    deck%base_dir = path(1:k)
+    allocate (deck%bodies(0), deck%restraints(0), deck%loads(0))
+    open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call add_problem(deck, 0, 'cannot open the deck: '//trim(msg))
+      return
+    end if
+    call scan_groups(u, deck, gname, gline)
+    if (deck%nproblems > 0) then
+      close (u); return
+    end if
+    call read_run(u, deck, line_of('run', 1))
+    call read_output(u, deck, line_of('output', 1))
+    call read_contact(u, deck, line_of('contact', 1))
+    call read_bodies(u, deck)
+    call read_restraints(u, deck)
+    call read_loads(u, deck)
+    close (u)
+    if (count(gname == 'run') > 1) call add_problem(deck, line_of('run', 2), '&run given twice')
+    if (count(gname == 'output') > 1) &
+      call add_problem(deck, line_of('output', 2), '&output given twice')
+    if (count(gname == 'contact') > 1) &
+      call add_problem(deck, line_of('contact', 2), '&contact given twice')
+    if (count(gname == 'run') == 0) call add_problem(deck, 0, 'no &run group')
+    if (count(gname == 'body') == 0) call add_problem(deck, 0, 'no &body group')
+  contains
+    !> line of the k-th group called name (0 if there is none)
+    integer function line_of(name, kth)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: kth
+      integer :: i, c
+      line_of = 0; c = 0
+      do i = 1, size(gname)
+        if (gname(i) == name) then
+          c = c + 1
+          if (c == kth) then
+            line_of = gline(i); return
+          end if
+        end if
+      end do
+    end function line_of
+
+    subroutine read_bodies(uu, dk)
+      integer, intent(in) :: uu
+      type(deck_t), intent(inout) :: dk
+      character(len=64) :: name
+      character(len=16) :: mesh
+      character(len=256) :: file
+      real(dp) :: radius, width, lx, ly, center(3), young, poisson, density, thickness
+      real(dp) :: velocity(3), omega(3)
+      integer :: n_around, n_across, n_div, nx, ny, ib
+      namelist /body/ name, mesh, file, radius, width, lx, ly, n_around, n_across, n_div, &
+        nx, ny, center, young, poisson, density, thickness, velocity, omega
+      type(body_cfg_t) :: b
+      rewind (uu)
+      do ib = 1, count(gname == 'body')
+        b = body_cfg_t()
+        name = b%name; mesh = b%mesh; file = b%file; radius = b%radius; width = b%width
+        lx = b%lx; ly = b%ly; n_around = b%n_around; n_across = b%n_across; n_div = b%n_div
+        nx = b%nx; ny = b%ny; center = b%center; young = b%young; poisson = b%poisson
+        density = b%density; thickness = b%thickness; velocity = b%velocity; omega = b%omega
+        read (uu, nml=body, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+          call add_problem(dk, line_of('body', ib), '&body: '//trim(msg))
+          return
+        end if
+        b%name = name; b%mesh = mesh; b%file = file; b%radius = radius; b%width = width
+        b%lx = lx; b%ly = ly; b%n_around = n_around; b%n_across = n_across; b%n_div = n_div
+        b%nx = nx; b%ny = ny; b%center = center; b%young = young; b%poisson = poisson
+        b%density = density; b%thickness = thickness; b%velocity = velocity; b%omega = omega
+        b%line = line_of('body', ib)
+        dk%bodies = [dk%bodies, b]
+      end do
+    end subroutine read_bodies
+
+    subroutine read_restraints(uu, dk)
+      integer, intent(in) :: uu
+      type(deck_t), intent(inout) :: dk
+      character(len=64) :: body, fix
+      real(dp) :: box_min(3), box_max(3)
+      namelist /restraint/ body, box_min, box_max, fix
+      type(restraint_cfg_t) :: r
+      integer :: ir
+      rewind (uu)
+      do ir = 1, count(gname == 'restraint')
+        r = restraint_cfg_t()
+        body = r%body; fix = r%fix; box_min = r%box_min; box_max = r%box_max
+        read (uu, nml=restraint, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+          call add_problem(dk, line_of('restraint', ir), '&restraint: '//trim(msg))
+          return
+        end if
+        r%body = body; r%fix = fix; r%box_min = box_min; r%box_max = box_max
+        r%line = line_of('restraint', ir)
+        dk%restraints = [dk%restraints, r]
+      end do
+    end subroutine read_restraints
+
+    subroutine read_loads(uu, dk)
+      integer, intent(in) :: uu
+      type(deck_t), intent(inout) :: dk
+      character(len=64) :: body
+      real(dp) :: box_min(3), box_max(3), force(3)
+      namelist /load/ body, box_min, box_max, force
+      type(load_cfg_t) :: l
+      integer :: il
+      rewind (uu)
+      do il = 1, count(gname == 'load')
+        l = load_cfg_t()
+        body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force
+        read (uu, nml=load, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+          call add_problem(dk, line_of('load', il), '&load: '//trim(msg))
+          return
+        end if
+        l%body = body; l%box_min = box_min; l%box_max = box_max; l%force = force
+        l%line = line_of('load', il)
+        dk%loads = [dk%loads, l]
+      end do
+    end subroutine read_loads
+  end subroutine read_deck
+
+  !> Names and lines of every '&group' in the file; unknown names are problems (a misspelt
+  !> group would otherwise be skipped silently by the namelist reader).
+  subroutine scan_groups(u, deck, gname, gline)
+    integer, intent(in) :: u
+    type(deck_t), intent(inout) :: deck
+    character(len=16), allocatable, intent(out) :: gname(:)
+    integer, allocatable, intent(out) :: gline(:)
+    character(len=1024) :: line
+    character(len=16) :: name
+    integer :: ios, n, j
+
+    allocate (gname(0), gline(0))
+    n = 0
+    do
+      read (u, '(a)', iostat=ios) line
+      if (ios == iostat_end) exit
+      if (ios /= 0) then
+        call add_problem(deck, n + 1, 'unreadable line'); exit
+      end if
+      n = n + 1
+      line = adjustl(line)
+      if (line(1:1) /= '&') cycle
+      j = scan(line(2:), ' /,'//achar(9))
+      if (j == 0) j = len_trim(line)
+      name = lower(line(2:j))
+      if (all(known_groups /= name)) then
+        call add_problem(deck, n, 'unknown group &'//trim(name)// &
+                         ' (known: &run, &output, &body, &restraint, &load, &contact)')
+        cycle
+      end if
+      if (name == 'end') cycle
+      gname = [gname, name]; gline = [gline, n]
+    end do
+    rewind (u)
+  end subroutine scan_groups
+
+  subroutine read_run(u, deck, line)
+    integer, intent(in) :: u, line
+    type(deck_t), intent(inout) :: deck
+    character(len=128) :: title
+    character(len=16) :: analysis, ordering
+    real(dp) :: dt, t_end, beta, gamma, newton_tol, gravity(3)
+    integer :: newton_max_iter, load_steps, max_step_cuts, ios
+    character(len=256) :: msg
+    namelist /run/ title, analysis, dt, t_end, beta, gamma, newton_tol, newton_max_iter, &
+      load_steps, max_step_cuts, gravity, ordering
+    associate (c => deck%run)
+      title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = c%beta
+      gamma = c%gamma; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
+      load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
+      ordering = c%ordering
+      if (line == 0) return
+      rewind (u)
+      read (u, nml=run, iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+        call add_problem(deck, line, '&run: '//trim(msg)); return
+      end if
+      c%title = title; c%analysis = lower(analysis); c%dt = dt; c%t_end = t_end; c%beta = beta
+      c%gamma = gamma; c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
+      c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
+      c%ordering = lower(ordering)
+    end associate
+  end subroutine read_run
+
+  subroutine read_output(u, deck, line)
+    integer, intent(in) :: u, line
+    type(deck_t), intent(inout) :: deck
+    character(len=256) :: dir, msg
+    real(dp) :: interval, checkpoint_interval, track(3, max_track)
+    character(len=64) :: track_body(max_track)
+    logical :: vtu, plots
+    integer :: ios, k
+    namelist /output/ dir, interval, vtu, plots, checkpoint_interval, track, track_body
+    associate (c => deck%output)
+      dir = c%dir; interval = c%interval; vtu = c%vtu; plots = c%plots
+      checkpoint_interval = c%checkpoint_interval
+      track = unset; track_body = ''
+      if (line == 0) return
+      rewind (u)
+      read (u, nml=output, iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+        call add_problem(deck, line, '&output: '//trim(msg)); return
+      end if
+      c%dir = dir; c%interval = interval; c%vtu = vtu; c%plots = plots
+      c%checkpoint_interval = checkpoint_interval
+      c%ntrack = 0
+      do k = 1, max_track
+        if (any(track(:, k) == unset)) exit
+        c%ntrack = k
+      end do
+      c%track = track; c%track_body = track_body
+      if (c%ntrack < max_track) then
+        if (any(track(:, c%ntrack + 1) /= unset)) &
+          call add_problem(deck, line, '&output: track needs 3 coordinates per point')
+      end if
+    end associate
+  end subroutine read_output
+
+  subroutine read_contact(u, deck, line)
+    integer, intent(in) :: u, line
+    type(deck_t), intent(inout) :: deck
+    logical :: enabled
+    character(len=64) :: pairs(2, max_pairs)
+    real(dp) :: tolerance
+    character(len=256) :: msg
+    integer :: ios, k
+    namelist /contact/ enabled, pairs, tolerance
+    associate (c => deck%contact)
+      enabled = c%enabled; pairs = ''; tolerance = c%tolerance
+      c%line = line
+      if (line == 0) return
+      rewind (u)
+      read (u, nml=contact, iostat=ios, iomsg=msg)
+      if (ios /= 0) then
+        call add_problem(deck, line, '&contact: '//trim(msg)); return
+      end if
+      c%enabled = enabled; c%tolerance = tolerance; c%pairs = pairs
+      c%npairs = 0
+      do k = 1, max_pairs
+        if (pairs(1, k) == '' .and. pairs(2, k) == '') exit
+        c%npairs = k
+        if (pairs(1, k) == '' .or. pairs(2, k) == '') &
+          call add_problem(deck, line, '&contact: pairs needs two body names per pair')
+      end do
+    end associate
+  end subroutine read_contact
+
+  pure function lower(s) result(t)
+    character(len=*), intent(in) :: s
+    character(len=len(s)) :: t
+    integer :: i
+    t = s
+    do i = 1, len(s)
+      if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
+    end do
+  end function lower
+end module casca_deck

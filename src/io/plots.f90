@@ -1,0 +1,512 @@
+!> Time-history plots of a run, drawn by gnuplot from DIR/history.dat.
+!>
+!> make_plots reads only the header of history.dat (to learn the column numbers and the number
+!> K of tracked nodes), writes DIR/plots.gp and runs it with gnuplot inside DIR. The script names
+!> files relative to DIR and keeps the column numbers in variables at its top, so a user can
+!> edit it and re-run `gnuplot plots.gp` in the run folder without casca. Columns are looked up
+!> by name (not position), so extra columns added to history.dat later do not break the plots.
+!>
+!> Units are SI as the solver writes them (s, m, J, N); time is plotted in ms.
+module casca_plots
+  use casca_error, only: error_t, fatal_error
+  implicit none
+  private
+  public :: make_plots
+
+  character(len=*), parameter :: nl = achar(10)
+  integer, parameter :: msg_len = 512
+  !> UTF-8 middle dot and superscript two for units (kept out of the source as raw bytes).
+  character(len=*), parameter :: mdot = char(194)//char(183), sup2 = char(194)//char(178)
+
+  !> One whitespace-separated token of a line.
+  type :: word_t
+    character(len=:), allocatable :: s
+  end type word_t
+
+  !> Columns every history.dat has (see the solver's history writer).
+  integer, parameter :: nreq = 15
+  character(len=*), parameter :: req_names(nreq) = [character(len=8) :: &
+    't', 'step', 'kinetic', 'strain', 'work', 'total', 'px', 'py', 'pz', &
+    'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton']
+  !> Per tracked node k: pk_x pk_y pk_z pk_vx pk_vy pk_vz.
+  character(len=*), parameter :: node_suffix(6) = [character(len=3) :: 'x', 'y', 'z', 'vx', 'vy', 'vz']
+
+contains
+
+  !> Write DIR/plots.gp from the header of DIR/history.dat and run gnuplot on it in DIR.
+  !> If gnuplot is not installed this is not an error: gnuplot_missing (if present) is set
+  !> .true. and the script is left for the user. A failing gnuplot run is an error.
+  subroutine make_plots(dir, err, gnuplot_missing)
+    character(len=*), intent(in) :: dir
+    type(error_t), allocatable, intent(out) :: err
+    logical, intent(out), optional :: gnuplot_missing
+
+    character(len=:), allocatable :: d, hist, script, cmd
+    type(word_t), allocatable :: labels(:)
+    integer :: col(nreq), nk, stat, cstat
+    integer, allocatable :: pcol(:, :)
+    character(len=msg_len) :: cmsg
+
+    if (present(gnuplot_missing)) gnuplot_missing = .false.
+    d = clean_dir(dir)
+    hist = d//'/history.dat'
+
+    call read_header(hist, col, pcol, err)
+    if (allocated(err)) return
+    nk = size(pcol, 2)
+    call read_labels(d//'/tracked.txt', nk, labels)
+
+    script = gnuplot_script(col, pcol, labels)
+    call write_text(d//'/plots.gp', script, err)
+    if (allocated(err)) return
+
+    ! The shell's `command -v` is the portable way to ask whether a program is on PATH. dash
+    ! answers 127 for "not found", which gfortran reports as a cmdstat failure, hence || exit 1.
+    cmsg = ''
+    call execute_command_line('command -v gnuplot >/dev/null 2>&1 || exit 1', exitstat=stat, &
+                              cmdstat=cstat, cmdmsg=cmsg)
+    if (cstat /= 0) then
+      call fatal_error(err, 'make_plots: cannot run shell commands (needed for gnuplot): ' &
+                       //trim(cmsg))
+      return
+    end if
+    if (stat /= 0) then
+      if (present(gnuplot_missing)) gnuplot_missing = .true.
+      return
+    end if
+
+    cmd = 'cd '//shell_quote(d)//' && gnuplot plots.gp'
+    cmsg = ''
+    call execute_command_line(cmd, exitstat=stat, cmdstat=cstat, cmdmsg=cmsg)
+    if (cstat /= 0) then
+      call fatal_error(err, 'make_plots: could not run `'//cmd//'`: '//trim(cmsg))
+    else if (stat /= 0) then
+      call fatal_error(err, 'make_plots: `'//cmd//'` failed with exit status '//itoa(stat))
+    end if
+  end subroutine make_plots
+
+  !> Read the '#' header of path into the column numbers of the required columns (col) and of
+  !> the tracked-node columns pcol(1:6, 1:K); also check that one data row follows with as
+  !> many numbers as the header has names (else gnuplot would silently plot wrong columns).
+  subroutine read_header(path, col, pcol, err)
+    character(len=*), intent(in) :: path
+    integer, intent(out) :: col(nreq)
+    integer, allocatable, intent(out) :: pcol(:, :)
+    type(error_t), allocatable, intent(out) :: err
+
+    character(len=:), allocatable :: line, head
+    character(len=msg_len) :: msg
+    type(word_t), allocatable :: names(:)
+    integer :: u, ios, i, j, k, nk, p
+
+    allocate (pcol(6, 0))
+    col = 0
+    open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call fatal_error(err, 'make_plots: cannot open '//path//': '//trim(msg))
+      return
+    end if
+
+    call read_line(u, line, ios)
+    if (ios /= 0) then
+      close (u)
+      call fatal_error(err, 'make_plots: '//path//' is empty (expected a "# t step ..." header)')
+      return
+    end if
+    head = adjustl(line)
+    if (len_trim(head) == 0) then
+      p = 0
+    else
+      p = index(head, '#')
+    end if
+    if (p /= 1) then
+      close (u)
+      call fatal_error(err, 'make_plots: '//path//': line 1 is not a "# t step ..." header')
+      return
+    end if
+    names = split(head(2:))
+
+    do i = 1, nreq
+      col(i) = find(names, trim(req_names(i)))
+      if (col(i) == 0) then
+        close (u)
+        call fatal_error(err, 'make_plots: '//path//': header has no column "' &
+                         //trim(req_names(i))//'"')
+        return
+      end if
+    end do
+
+    ! Tracked nodes are numbered 1..K without gaps; all six columns of each must be present.
+    nk = 0
+    do while (find(names, 'p'//itoa(nk + 1)//'_x') > 0)
+      nk = nk + 1
+    end do
+    deallocate (pcol)
+    allocate (pcol(6, nk))
+    do k = 1, nk
+      do j = 1, 6
+        pcol(j, k) = find(names, 'p'//itoa(k)//'_'//trim(node_suffix(j)))
+        if (pcol(j, k) == 0) then
+          close (u)
+          call fatal_error(err, 'make_plots: '//path//': header has no column "p'//itoa(k) &
+                           //'_'//trim(node_suffix(j))//'"')
+          return
+        end if
+      end do
+    end do
+
+    call read_line(u, line, ios)
+    close (u)
+    if (ios /= 0) then
+      call fatal_error(err, 'make_plots: '//path//' has a header but no data rows')
+      return
+    end if
+    if (nwords(line) /= size(names)) then
+      call fatal_error(err, 'make_plots: '//path//': header names '//itoa(size(names)) &
+                       //' columns but row 1 has '//itoa(nwords(line)))
+      return
+    end if
+  end subroutine read_header
+
+  !> Labels of the tracked nodes: line k of path (tracked.txt), or "node k" if the file or
+  !> the line is missing or blank.
+  subroutine read_labels(path, nk, labels)
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: nk
+    type(word_t), allocatable, intent(out) :: labels(:)
+
+    character(len=:), allocatable :: line
+    integer :: u, ios, k
+    logical :: exists
+
+    allocate (labels(nk))
+    do k = 1, nk
+      labels(k)%s = 'node '//itoa(k)
+    end do
+    inquire (file=path, exist=exists)
+    if (exists) then
+      open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios)
+      if (ios == 0) then
+        do k = 1, nk
+          call read_line(u, line, ios)
+          if (ios /= 0) exit
+          line = trim(adjustl(untab(line)))
+          if (len(line) > 0) labels(k)%s = line
+        end do
+        close (u)
+      end if
+    end if
+  end subroutine read_labels
+
+  !> The gnuplot script. Column numbers go in variables at the top so the plot commands read
+  !> by name; the terminal falls back to libgd `png` where cairo is not built in.
+  function gnuplot_script(col, pcol, labels) result(s)
+    integer, intent(in) :: col(nreq), pcol(:, :)
+    type(word_t), intent(in) :: labels(:)
+    character(len=:), allocatable :: s
+
+    character(len=*), parameter :: axis(3) = ['x', 'y', 'z']
+    character(len=:), allocatable :: v
+    integer :: i, k, a, nk
+
+    nk = size(pcol, 2)
+    s = '# Time-history plots of a casca run, written by casca from the header of history.dat.' &
+        //nl//'# Edit freely and re-run inside the run folder with:  gnuplot plots.gp'//nl// &
+        '# history.dat is in SI units (s, m, J, N); time is plotted in ms.'//nl//nl// &
+        "datafile = 'history.dat'"//nl//nl//'# Column numbers in history.dat'//nl
+    do i = 1, nreq
+      s = s//'c_'//trim(req_names(i))//' = '//itoa(col(i))//nl
+    end do
+    do k = 1, nk
+      s = s//'# tracked node '//itoa(k)//': '//comment_safe(labels(k)%s)//nl
+      do a = 1, 6
+        s = s//'c_p'//itoa(k)//'_'//trim(node_suffix(a))//' = '//itoa(pcol(a, k))//nl
+      end do
+    end do
+
+    s = s//nl// &
+        'ms(c) = column(c)*1.0e3   # s -> ms'//nl// &
+        'imax(a, b) = (a > b) ? a : b'//nl//nl// &
+        '# Terminal: cairo if available (antialiased), else libgd. Text is not "enhanced", so'//nl// &
+        '# labels with _ or ^ print literally; units use UTF-8 characters instead.'//nl// &
+        'set encoding utf8'//nl// &
+        "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {"//nl// &
+        '  term = "pngcairo noenhanced font ''Sans,12''"'//nl// &
+        '} else {'//nl// &
+        "  term = 'png noenhanced'"//nl// &
+        '}'//nl// &
+        'set terminal @term size 1000,600'//nl//nl// &
+        'set style line 100 lc rgb "#c8c8c8" lw 1 dt 1'//nl// &
+        'set grid xtics ytics ls 100'//nl// &
+        "set title font ',14'"//nl// &
+        'set key below horizontal spacing 1.2 width 2'//nl// &
+        '# 5 % head room so curves at their extremes do not hide under the frame'//nl// &
+        'set offsets 0, 0, graph 0.05, graph 0.05'//nl// &
+        '# axes fit the data (plus the offsets above) instead of growing to the next tic'//nl// &
+        'set autoscale fix'//nl// &
+        "set xlabel 'time [ms]'"//nl// &
+        'set linetype 1 lc rgb "#1f77b4" lw 2 dt 1'//nl// &
+        'set linetype 2 lc rgb "#d62728" lw 2 dt 1'//nl// &
+        'set linetype 3 lc rgb "#2ca02c" lw 2 dt 1'//nl// &
+        'set linetype 4 lc rgb "#000000" lw 2 dt 2'//nl// &
+        'set linetype 5 lc rgb "#9467bd" lw 2 dt 1'//nl// &
+        'set linetype 6 lc rgb "#ff7f0e" lw 2 dt 1'//nl// &
+        'set linetype 7 lc rgb "#8c564b" lw 2 dt 1'//nl// &
+        'set linetype 8 lc rgb "#17becf" lw 2 dt 1'//nl// &
+        'set linetype cycle 8'//nl//nl
+
+    ! Positions of the tracked nodes (the thesis' "Time x Position in x of impactor and target
+    ! nodes"); nothing to draw when no node is tracked.
+    if (nk > 0) then
+      do a = 1, 3
+        s = s//'# '//axis(a)//' position of every tracked node'//nl// &
+            "set output 'positions_"//axis(a)//".png'"//nl// &
+            "set title 'Position in "//axis(a)//" of the tracked nodes vs time'"//nl// &
+            "set ylabel '"//axis(a)//" [m]'"//nl//'plot '
+        do k = 1, nk
+          v = 'c_p'//itoa(k)//'_'//axis(a)
+          if (k > 1) s = s//', \'//nl//'     '
+          s = s//"datafile using (ms(c_t)):(column("//v//")) with lines lt "//itoa(k) &
+              //" title '"//gp_quote(labels(k)%s)//"'"
+        end do
+        s = s//nl//nl
+      end do
+    else
+      s = s//'# No tracked nodes in history.dat: no position plots.'//nl//nl
+    end if
+
+    s = s//'# Energy balance'//nl// &
+        "set output 'energy.png'"//nl// &
+        "set title 'Energies vs time'"//nl// &
+        "set ylabel 'energy [J]'"//nl// &
+        "plot datafile using (ms(c_t)):(column(c_kinetic)) with lines lt 1 title 'kinetic', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_strain)) with lines lt 2 title 'strain', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_work)) with lines lt 3 title 'work', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_total)) with lines lt 4 title 'total'"//nl//nl
+
+    s = s//'# Linear (top) and angular (bottom) momentum'//nl// &
+        'set terminal @term size 1000,800'//nl// &
+        "set output 'momentum.png'"//nl// &
+        "set multiplot layout 2,1 title 'Momentum vs time' font ',15'"//nl// &
+        "set title 'linear momentum'"//nl// &
+        "set ylabel 'p [kg"//mdot//"m/s]'"//nl// &
+        "plot datafile using (ms(c_t)):(column(c_px)) with lines lt 1 title 'px', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_py)) with lines lt 2 title 'py', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_pz)) with lines lt 3 title 'pz'"//nl// &
+        "set title 'angular momentum (about the origin)'"//nl// &
+        "set ylabel 'L [kg"//mdot//"m"//sup2//"/s]'"//nl// &
+        "plot datafile using (ms(c_t)):(column(c_Lx)) with lines lt 1 title 'Lx', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_Ly)) with lines lt 2 title 'Ly', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_Lz)) with lines lt 3 title 'Lz'"//nl// &
+        'unset multiplot'//nl// &
+        'set terminal @term size 1000,600'//nl//nl
+
+    ! Counts are integers: integer tick steps, and a y range that starts at 0 and is not empty
+    ! when nothing is in contact (gnuplot would warn about an empty range).
+    s = s//'# Contact: number of active contacts (left axis), total contact force (right axis)'//nl// &
+        "stats datafile using c_contacts nooutput name 'CONT'"//nl// &
+        "stats datafile using c_fcontact nooutput name 'FCON'"//nl// &
+        "set output 'contact.png'"//nl// &
+        "set title 'Contact vs time'"//nl// &
+        "set ylabel 'active contacts [-]' textcolor lt 1"//nl// &
+        "set y2label 'total contact force [N]' textcolor lt 2"//nl// &
+        'set yrange [0:imax(1, CONT_max*1.1)]'//nl// &
+        'set ytics nomirror imax(1, ceil(CONT_max/8.0))'//nl// &
+        'if (FCON_max > FCON_min) {'//nl// &
+        '  set y2range [(FCON_min < 0 ? 1.1*FCON_min : 0):FCON_max + 0.1*(FCON_max - FCON_min)]'//nl// &
+        '} else {'//nl// &
+        '  set y2range [(FCON_min < 0 ? FCON_min - 1 : 0):FCON_max + 1]'//nl// &
+        '}'//nl// &
+        'set y2tics'//nl// &
+        'set grid noy2tics'//nl// &
+        "plot datafile using (ms(c_t)):(column(c_contacts)) with steps lt 1 title 'active contacts (left axis)', \"//nl// &
+        "     datafile using (ms(c_t)):(column(c_fcontact)) axes x1y2 with lines lt 2 title 'contact force (right axis)'"//nl// &
+        'unset y2tics; unset y2label; set ylabel textcolor default'//nl// &
+        'set ytics mirror autofreq; set yrange [*:*]'//nl//nl
+
+    s = s//'# Newton iterations per time step'//nl// &
+        "stats datafile using c_newton nooutput name 'NEWT'"//nl// &
+        "set output 'newton.png'"//nl// &
+        "set title 'Newton iterations per time step'"//nl// &
+        "set ylabel 'Newton iterations [-]'"//nl// &
+        'set yrange [0:imax(1, NEWT_max+1)]'//nl// &
+        'set ytics imax(1, ceil(NEWT_max/10.0))'//nl// &
+        "plot datafile using (ms(c_t)):(column(c_newton)) with steps lt 1 title 'iterations'"//nl// &
+        'set ytics autofreq; set yrange [*:*]'//nl// &
+        'unset output'//nl
+  end function gnuplot_script
+
+  !> Write s to path (replacing it).
+  subroutine write_text(path, s, err)
+    character(len=*), intent(in) :: path, s
+    type(error_t), allocatable, intent(out) :: err
+    character(len=msg_len) :: msg
+    integer :: u, ios
+    open (newunit=u, file=path, status='replace', action='write', form='formatted', &
+          iostat=ios, iomsg=msg)
+    if (ios == 0) write (u, '(a)', iostat=ios, iomsg=msg) s
+    if (ios == 0) then
+      close (u, iostat=ios, iomsg=msg)
+    else
+      close (u)
+    end if
+    if (ios /= 0) call fatal_error(err, 'make_plots: cannot write '//path//': '//trim(msg))
+  end subroutine write_text
+
+  !> Read one line of any length; ios = 0 on success, non-zero at end of file (a last line
+  !> without newline still counts as a line).
+  subroutine read_line(u, line, ios)
+    integer, intent(in) :: u
+    character(len=:), allocatable, intent(out) :: line
+    integer, intent(out) :: ios
+    character(len=1024) :: buf
+    integer :: sz
+    logical :: got
+    line = ''
+    got = .false.
+    do
+      read (u, '(a)', advance='no', iostat=ios, size=sz) buf
+      if (sz > 0) got = .true.
+      line = line//buf(:sz)
+      if (ios /= 0) exit
+    end do
+    if (is_iostat_eor(ios)) ios = 0
+    if (is_iostat_end(ios) .and. got) ios = 0
+  end subroutine read_line
+
+  !> Split a line at blanks, tabs and carriage returns.
+  function split(line) result(w)
+    character(len=*), intent(in) :: line
+    type(word_t), allocatable :: w(:)
+    integer :: i, n, start, pass
+    do pass = 1, 2
+      n = 0
+      start = 0
+      do i = 1, len(line) + 1
+        if (i <= len(line)) then
+          if (.not. is_space(line(i:i))) then
+            if (start == 0) start = i
+            cycle
+          end if
+        end if
+        if (start > 0) then
+          n = n + 1
+          if (pass == 2) w(n)%s = line(start:i - 1)
+          start = 0
+        end if
+      end do
+      if (pass == 1) allocate (w(n))
+    end do
+  end function split
+
+  !> Number of words split(line) would return.
+  pure integer function nwords(line)
+    character(len=*), intent(in) :: line
+    integer :: i
+    logical :: prev_space
+    nwords = 0
+    prev_space = .true.
+    do i = 1, len(line)
+      if (prev_space .and. .not. is_space(line(i:i))) nwords = nwords + 1
+      prev_space = is_space(line(i:i))
+    end do
+  end function nwords
+
+  pure logical function is_space(c)
+    character(len=1), intent(in) :: c
+    is_space = c == ' ' .or. c == achar(9) .or. c == achar(13)
+  end function is_space
+
+  !> Index of the first word equal to name, 0 if none.
+  pure integer function find(w, name)
+    type(word_t), intent(in) :: w(:)
+    character(len=*), intent(in) :: name
+    integer :: i
+    find = 0
+    do i = 1, size(w)
+      if (w(i)%s == name) then
+        find = i
+        return
+      end if
+    end do
+  end function find
+
+  !> dir without trailing slashes ('.' for an empty name, '/' kept).
+  pure function clean_dir(dir) result(d)
+    character(len=*), intent(in) :: dir
+    character(len=:), allocatable :: d
+    integer :: n
+    n = len_trim(dir)
+    do while (n > 1)
+      if (dir(n:n) /= '/') exit
+      n = n - 1
+    end do
+    if (n == 0) then
+      d = '.'
+    else
+      d = dir(:n)
+    end if
+  end function clean_dir
+
+  !> s as one POSIX shell word: inside '...' nothing is special except ' itself, written '\''.
+  pure function shell_quote(s) result(q)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: q
+    integer :: i
+    q = "'"
+    do i = 1, len(s)
+      if (s(i:i) == "'") then
+        q = q//"'\''"
+      else
+        q = q//s(i:i)
+      end if
+    end do
+    q = q//"'"
+  end function shell_quote
+
+  !> Body of a gnuplot single-quoted string: only ' is special there, written ''.
+  pure function gp_quote(s) result(q)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: q
+    integer :: i
+    q = ''
+    do i = 1, len(s)
+      if (s(i:i) == "'") then
+        q = q//"''"
+      else if (iachar(s(i:i)) < 32) then
+        q = q//' '            ! control characters would end or garble the command
+      else
+        q = q//s(i:i)
+      end if
+    end do
+  end function gp_quote
+
+  !> Text for a gnuplot comment line: no control characters (a newline would end it).
+  pure function comment_safe(s) result(q)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: q
+    integer :: i
+    q = s
+    do i = 1, len(q)
+      if (iachar(q(i:i)) < 32) q(i:i) = ' '
+    end do
+  end function comment_safe
+
+  pure function untab(s) result(q)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: q
+    integer :: i
+    q = s
+    do i = 1, len(q)
+      if (q(i:i) == achar(9) .or. q(i:i) == achar(13)) q(i:i) = ' '
+    end do
+  end function untab
+
+  pure function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=16) :: buf
+    write (buf, '(i0)') i
+    s = trim(buf)
+  end function itoa
+end module casca_plots

@@ -1,0 +1,184 @@
+!> From a checked deck to the model: meshes (generated or read), materials, restraints,
+!> loads, the initial state and the tracked nodes. Problems are added to the deck's list.
+module casca_scene
+  use casca_kinds, only: dp
+  use casca_error, only: error_t
+  use casca_mesh, only: mesh_t
+  use casca_mesh_generators, only: mesh_ring, mesh_sphere, mesh_plate
+  use casca_gmsh_io, only: read_gmsh
+  use casca_deck, only: deck_t, add_problem
+  use casca_sanity, only: parse_fix
+  use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
+  use casca_newmark, only: state_t
+  implicit none
+  private
+  public :: build_model, initial_state, tracked_nodes, body_mesh
+
+contains
+
+  !> The mesh of body ib as the deck describes it, moved to its centre.
+  subroutine body_mesh(deck, ib, mesh, err)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: ib
+    type(mesh_t), intent(out) :: mesh
+    type(error_t), allocatable, intent(out) :: err
+    integer :: i
+    associate (b => deck%bodies(ib))
+      select case (b%mesh)
+      case ('ring')
+        call mesh_ring(b%radius, b%width, b%n_around, b%n_across, mesh, err)
+      case ('sphere')
+        call mesh_sphere(b%radius, b%n_div, mesh, err)
+      case ('plate', 'strip')
+        call mesh_plate(b%lx, b%ly, b%nx, b%ny, mesh, err)
+      case ('file')
+        call read_gmsh(deck%base_dir//trim(b%file), mesh, err)
+      end select
+      if (allocated(err)) return
+      do i = 1, mesh%nnode
+        mesh%x(:, i) = mesh%x(:, i) + b%center
+      end do
+    end associate
+  end subroutine body_mesh
+
+  subroutine build_model(deck, model)
+    type(deck_t), intent(inout) :: deck
+    type(model_t), intent(out) :: model
+    type(mesh_t) :: mesh
+    type(error_t), allocatable :: err
+    logical :: comps(7), ok
+    integer :: ib, i, n, c, nsel
+    integer, allocatable :: sel(:)
+
+    do ib = 1, size(deck%bodies)
+      call body_mesh(deck, ib, mesh, err)
+      if (allocated(err)) then
+        call add_problem(deck, deck%bodies(ib)%line, '&body '//trim(deck%bodies(ib)%name)// &
+                         ': '//err%message)
+        cycle
+      end if
+      if (mesh%nelem == 0) then
+        call add_problem(deck, deck%bodies(ib)%line, '&body '//trim(deck%bodies(ib)%name)// &
+                         ': the mesh has no 10-node triangle')
+        cycle
+      end if
+      associate (b => deck%bodies(ib))
+        call model_add_body(model, trim(b%name), mesh, b%young, b%poisson, b%density, b%thickness)
+      end associate
+    end do
+    if (deck%nproblems > 0) return
+    call model_finalize(model, err)
+    if (allocated(err)) then
+      call add_problem(deck, 0, err%message); return
+    end if
+
+    do i = 1, size(deck%restraints)
+      associate (r => deck%restraints(i))
+        sel = select_nodes(r%body, r%box_min, r%box_max)
+        if (size(sel) == 0) then
+          call add_problem(deck, r%line, '&restraint: no node of '//body_label(r%body)// &
+                           ' lies inside box_min..box_max'); cycle
+        end if
+        call parse_fix(r%fix, comps, ok)
+        do c = 1, 7
+          if (comps(c)) model%fixed(dof(sel, c)) = .true.
+        end do
+      end associate
+    end do
+    do i = 1, size(deck%loads)
+      associate (l => deck%loads(i))
+        sel = select_nodes(l%body, l%box_min, l%box_max)
+        nsel = size(sel)
+        if (nsel == 0) then
+          call add_problem(deck, l%line, '&load: no node of '//body_label(l%body)// &
+                           ' lies inside box_min..box_max'); cycle
+        end if
+        do n = 1, nsel
+          model%fext(dof(sel(n), 1):dof(sel(n), 3)) = model%fext(dof(sel(n), 1):dof(sel(n), 3)) &
+                                                      + l%force/nsel
+        end do
+      end associate
+    end do
+    model%gravity = deck%run%gravity
+  contains
+    function select_nodes(body, lo, hi) result(s)
+      character(len=*), intent(in) :: body
+      real(dp), intent(in) :: lo(3), hi(3)
+      integer, allocatable :: s(:)
+      logical, allocatable :: mask(:)
+      integer :: k, kb
+      allocate (mask(model%nnode))
+      do k = 1, model%nnode
+        mask(k) = all(model%x0(:, k) >= lo) .and. all(model%x0(:, k) <= hi)
+      end do
+      if (body /= '') then
+        kb = findloc([(model%body(k)%name == body, k=1, model%nbody)], .true., dim=1)
+        mask = mask .and. model%node_body == kb
+      end if
+      s = pack([(k, k=1, model%nnode)], mask)
+    end function select_nodes
+
+    function body_label(body) result(s)
+      character(len=*), intent(in) :: body
+      character(len=:), allocatable :: s
+      if (body == '') then
+        s = 'any body'
+      else
+        s = 'body '''//trim(body)//''''
+      end if
+    end function body_label
+  end subroutine build_model
+
+  !> Unstressed initial state moving with each body's velocity and spin (about its centroid).
+  subroutine initial_state(deck, model, st)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    type(state_t), intent(out) :: st
+    real(dp) :: c(3), w(3)
+    integer :: ib, n
+    allocate (st%q(model%ndof), st%qd(model%ndof), st%qdd(model%ndof))
+    call reference_state(model, st%q)
+    st%qd = 0; st%qdd = 0
+    do ib = 1, model%nbody
+      associate (b => model%body(ib))
+        c = sum(model%x0(:, b%node_first:b%node_last), dim=2)/(b%node_last - b%node_first + 1)
+        w = deck%bodies(ib)%omega
+        do n = b%node_first, b%node_last
+          st%qd(dof(n, 1):dof(n, 3)) = deck%bodies(ib)%velocity + cross(w, model%x0(:, n) - c)
+          st%qd(dof(n, 4):dof(n, 6)) = cross(w, model%v0(:, n))
+        end do
+      end associate
+    end do
+    where (model%fixed) st%qd = 0
+  end subroutine initial_state
+
+  !> The node nearest to each tracked point (of the named body, if one is given).
+  subroutine tracked_nodes(deck, model, nodes)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    integer, allocatable, intent(out) :: nodes(:)
+    integer :: k, n, kb
+    real(dp) :: d, best
+    allocate (nodes(deck%output%ntrack))
+    do k = 1, deck%output%ntrack
+      kb = 0
+      if (deck%output%track_body(k) /= '') &
+        kb = findloc([(model%body(n)%name == deck%output%track_body(k), n=1, model%nbody)], &
+                     .true., dim=1)
+      best = huge(1._dp); nodes(k) = 1
+      do n = 1, model%nnode
+        if (kb > 0 .and. model%node_body(n) /= kb) cycle
+        d = norm2(model%x0(:, n) - deck%output%track(:, k))
+        if (d < best) then
+          best = d; nodes(k) = n
+        end if
+      end do
+    end do
+  end subroutine tracked_nodes
+
+  pure function cross(a, b) result(c)
+    real(dp), intent(in) :: a(3), b(3)
+    real(dp) :: c(3)
+    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+  end function cross
+end module casca_scene
