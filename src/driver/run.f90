@@ -13,7 +13,9 @@ module casca_run
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
   use casca_accounting, only: balance_t, account, gravity_load
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close
-  use casca_vtu_writer, only: field_t
+  use casca_vtu_writer, only: field_t, field
+  use casca_contact, only: contact_t, contact_init, contact_force_total, contact_nodal_fields, &
+                           contact_penetration, contact_signed_distance
   use casca_hdf5_io, only: write_checkpoint, read_checkpoint
   use casca_plots, only: make_plots
   use casca_mpi, only: is_root, wall_time, n_ranks
@@ -61,6 +63,7 @@ contains
     type(newmark_t) :: nm
     type(balance_t) :: bal
     type(output_t) :: out
+    type(contact_t) :: contact
     type(error_t), allocatable :: err
     real(dp), allocatable :: fext(:), fgrav(:), q0(:)
     integer, allocatable :: tracked(:), ints(:)
@@ -68,7 +71,8 @@ contains
     character(len=:), allocatable :: dir
     real(dp) :: interval, next_frame, next_ckpt, t0, t_start, dt
     integer :: level, k, restart_step, total_newton
-    logical :: missing
+    logical :: missing, use_contact
+    real(dp) :: pen, gmax
 
     code = exit_ok
     call load_scene(path, deck, model, code)
@@ -91,6 +95,7 @@ contains
         ' near (', deck%output%track(:, k)
       labels(k) = trim(labels(k))//')'
     end do
+    call setup_contact()
     call initial_state(deck, model, st)
     allocate (q0(model%ndof))
     call reference_state(model, q0)
@@ -108,6 +113,15 @@ contains
         code = exit_input; return
       end if
       if (size(ints) >= 1) level = ints(1)
+      if (use_contact .and. size(ints) >= 2) then   ! the active set: (node, pair) per constraint
+        contact%nact = ints(2)
+        if (size(contact%act) < contact%nact) deallocate (contact%act)
+        if (.not. allocated(contact%act)) allocate (contact%act(contact%nact))
+        do k = 1, contact%nact
+          contact%act(k)%node = ints(1 + 2*k); contact%act(k)%pair = ints(2 + 2*k)
+          contact%act(k)%elem = 0
+        end do
+      end if
       restart_step = st%step
     end if
     call output_open(out, dir, tracked, labels, restart_step, st%t, err)
@@ -130,9 +144,9 @@ contains
       next_ckpt = (floor(st%t/deck%output%checkpoint_interval + 1e-9_dp) + 1)*deck%output%checkpoint_interval
     if (restart_step < 0) then
       call account(model, asm, st, fext, q0, bal)
-      call output_history(out, st, bal, 0, 0._dp, 0, err)
+      call history_row(0)
       if (failed('history')) return
-      if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], err)
+      call frame()
       if (failed('frame')) return
     end if
     if (is_root() .and. .not. quiet) print '(a,i0,a,i0,a,i0,a,i0,a)', 'casca: ', model%nbody, &
@@ -141,7 +155,11 @@ contains
     total_newton = 0
     do while (st%t < deck%run%t_end - 1e-9_dp*dt)
       nm%dt = min(dt/2**level, deck%run%t_end - st%t)
-      call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err)
+      if (use_contact) then
+        call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
+      else
+        call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err)
+      end if
       if (allocated(err)) then
         if (level < deck%run%max_step_cuts) then
           level = level + 1   ! the state is unchanged: retry with half the step
@@ -156,10 +174,10 @@ contains
       total_newton = total_newton + rep%iters
       if (level > 0 .and. rep%iters <= 3) level = level - 1   ! Newton is at ease: grow back
       call account(model, asm, st, fext, q0, bal)
-      call output_history(out, st, bal, 0, 0._dp, rep%iters, err)
+      call history_row(rep%iters)
       if (failed('history')) return
       if (st%t >= next_frame - 1e-9_dp*dt .or. st%t >= deck%run%t_end - 1e-9_dp*dt) then
-        if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], err)
+        call frame()
         if (failed('frame')) return
         next_frame = next_frame + interval
         if (is_root() .and. .not. quiet) call progress()
@@ -176,6 +194,57 @@ contains
 
   contains
 
+    !> contact pairs of the deck (default: every pair of bodies, the earlier one impacting)
+    subroutine setup_contact()
+      integer, allocatable :: pairs(:, :)
+      integer :: i, j, p
+      use_contact = deck%contact%enabled .and. model%nbody > 1
+      if (.not. use_contact) return
+      if (deck%contact%npairs > 0) then
+        allocate (pairs(2, deck%contact%npairs))
+        do p = 1, deck%contact%npairs
+          do j = 1, 2
+            pairs(j, p) = findloc([(model%body(i)%name == deck%contact%pairs(j, p), &
+                                    i=1, model%nbody)], .true., dim=1)
+          end do
+        end do
+      else
+        allocate (pairs(2, 0))
+        do i = 1, model%nbody
+          do j = i + 1, model%nbody
+            pairs = reshape([pairs, i, j], [2, size(pairs, 2) + 1])
+          end do
+        end do
+      end if
+      call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
+    end subroutine setup_contact
+
+    subroutine history_row(newton)
+      integer, intent(in) :: newton
+      pen = 0; gmax = 0
+      if (use_contact) then
+        call contact_penetration(contact, model, st%q, pen, gmax)
+        call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
+                            max(pen, 0._dp), err)
+      else
+        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, err)
+      end if
+    end subroutine history_row
+
+    subroutine frame()
+      real(dp), allocatable :: fc(:, :), sd(:, :)
+      if (.not. deck%output%vtu) return
+      if (use_contact) then
+        allocate (fc(3, model%nnode), sd(1, model%nnode))
+        call contact_nodal_fields(contact, model, fc)
+        call contact_signed_distance(contact, model, st%q, sd(1, :))
+        call output_frame(out, model, st, [field('contact_force', fc), &
+                                           field('signed_distance', sd)], err)
+      else
+        call output_frame(out, model, st, [field_t ::], err)
+      end if
+    end subroutine frame
+
     logical function failed(what)
       character(len=*), intent(in) :: what
       failed = allocated(err)
@@ -191,14 +260,20 @@ contains
       el = wall_time() - t0
       print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
         '  dt', nm%dt, '  newton/step', real(total_newton)/max(st%step - max(restart_step, 0), 1), &
-        '  contacts', 0, '  elapsed', el, ' s  left', &
+        '  contacts', merge(contact%nact, 0, use_contact), '  elapsed', el, ' s  left', &
         el*max(deck%run%t_end - st%t, 0._dp)/max(st%t - t_start, tiny(1._dp)), ' s'
     end subroutine progress
 
     subroutine checkpoint()
       type(error_t), allocatable :: e
       if (.not. is_root()) return
-      call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, [level], e)
+      if (use_contact) then
+        call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, &
+                              [level, contact%nact, (contact%act(k)%node, contact%act(k)%pair, &
+                                                     k=1, contact%nact)], e)
+      else
+        call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, [level], e)
+      end if
       if (allocated(e)) then
         write (0, '(a,a)') 'error (checkpoint): ', e%message
         code = exit_solver
@@ -211,7 +286,7 @@ contains
       type(error_t), allocatable :: e
       if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', st%t, &
         ' s: ', why
-      if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], e)
+      call frame()
       call checkpoint()
       call output_close(out, e)
       if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
@@ -241,16 +316,21 @@ contains
     subroutine static_run()
       integer :: i
       do i = 1, deck%run%load_steps
-        call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
-                          opts, st%q, rep, err)
+        if (use_contact) then
+          call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
+                            opts, st%q, rep, err, contact)
+        else
+          call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
+                            opts, st%q, rep, err)
+        end if
         if (allocated(err)) then
           call give_up(err%message); return
         end if
         st%t = real(i, dp)/deck%run%load_steps; st%step = i
         call account(model, asm, st, fext*st%t, q0, bal)
-        call output_history(out, st, bal, 0, 0._dp, rep%iters, err)
+        call history_row(rep%iters)
         if (failed('history')) return
-        if (deck%output%vtu) call output_frame(out, model, st, [field_t ::], err)
+        call frame()
         if (failed('frame')) return
         if (is_root() .and. .not. quiet) print '(a,i4,a,f6.3,a,i3)', 'load step', i, &
           '  factor', st%t, '  newton', rep%iters

@@ -13,7 +13,7 @@ module casca_deck
   implicit none
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
-  public :: contact_cfg_t, read_deck, add_problem, max_track, unset
+  public :: contact_cfg_t, read_deck, add_problem, max_track, unset, deck_file
 
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
@@ -51,7 +51,9 @@ module casca_deck
     character(len=256) :: file = ''
     real(dp) :: radius = 1, width = 0.2_dp, lx = 1, ly = 1
     integer :: n_around = 20, n_across = 1, n_div = 6, nx = 4, ny = 1
-    real(dp) :: center(3) = 0                   !< the generated or read mesh is moved here
+    real(dp) :: rotate_axis(3) = [0, 0, 1]      !< the mesh is first rotated about this axis ...
+    real(dp) :: rotate_angle = 0                !< ... by this angle [degrees]
+    real(dp) :: center(3) = 0                   !< ... and then moved by this vector
     real(dp) :: young = unset, poisson = 0.3_dp, density = unset, thickness = unset
     real(dp) :: velocity(3) = 0, omega(3) = 0   !< omega about the body's centroid
     integer :: line = 0
@@ -93,6 +95,18 @@ module casca_deck
   end type deck_t
 
 contains
+
+  !> A file named in the deck: relative names are relative to the deck's folder.
+  function deck_file(deck, name) result(path)
+    type(deck_t), intent(in) :: deck
+    character(len=*), intent(in) :: name
+    character(len=:), allocatable :: path
+    if (name(1:1) == '/') then
+      path = trim(name)
+    else
+      path = deck%base_dir//trim(name)
+    end if
+  end function deck_file
 
   subroutine add_problem(deck, line, msg)
     type(deck_t), intent(inout) :: deck
@@ -175,10 +189,11 @@ contains
       character(len=16) :: mesh
       character(len=256) :: file
       real(dp) :: radius, width, lx, ly, center(3), young, poisson, density, thickness
+      real(dp) :: rotate_axis(3), rotate_angle
       real(dp) :: velocity(3), omega(3)
       integer :: n_around, n_across, n_div, nx, ny, ib
       namelist /body/ name, mesh, file, radius, width, lx, ly, n_around, n_across, n_div, &
-        nx, ny, center, young, poisson, density, thickness, velocity, omega
+        nx, ny, center, rotate_axis, rotate_angle, young, poisson, density, thickness, velocity, omega
       type(body_cfg_t) :: b
       rewind (uu)
       do ib = 1, count(gname == 'body')
@@ -187,6 +202,7 @@ contains
         lx = b%lx; ly = b%ly; n_around = b%n_around; n_across = b%n_across; n_div = b%n_div
         nx = b%nx; ny = b%ny; center = b%center; young = b%young; poisson = b%poisson
         density = b%density; thickness = b%thickness; velocity = b%velocity; omega = b%omega
+        rotate_axis = b%rotate_axis; rotate_angle = b%rotate_angle
         read (uu, nml=body, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('body', ib), '&body: '//trim(msg))
@@ -196,6 +212,7 @@ contains
         b%lx = lx; b%ly = ly; b%n_around = n_around; b%n_across = n_across; b%n_div = n_div
         b%nx = nx; b%ny = ny; b%center = center; b%young = young; b%poisson = poisson
         b%density = density; b%thickness = thickness; b%velocity = velocity; b%omega = omega
+        b%rotate_axis = rotate_axis; b%rotate_angle = rotate_angle
         b%line = line_of('body', ib)
         dk%bodies = [dk%bodies, b]
       end do

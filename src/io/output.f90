@@ -17,8 +17,6 @@ module casca_output
   private
   public :: output_t, output_open, output_history, output_frame, output_close, history_columns
 
-  integer, parameter :: nfixed_cols = 15
-
   type :: output_t
     character(len=:), allocatable :: dir
     integer :: hist = 0                 !< unit of history.dat (newunit: negative)
@@ -41,7 +39,7 @@ contains
     character(len=8) :: p
     integer :: k, c
     cols = [character(len=16) :: 't', 'step', 'kinetic', 'strain', 'work', 'total', 'px', 'py', &
-            'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton']
+            'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton', 'penetration']
     do k = 1, ntrack
       write (p, '(a,i0)') 'p', k
       do c = 1, 6
@@ -159,19 +157,20 @@ contains
     end subroutine keep_frames
   end subroutine output_open
 
-  !> One row: time, energies, momenta, contacts, Newton iterations, tracked nodes.
-  subroutine output_history(out, st, bal, contacts, fcontact, newton, err)
+  !> One row: time, energies, momenta, contacts, Newton iterations, deepest penetration of a
+  !> node without constraint, tracked nodes.
+  subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, err)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
     integer, intent(in) :: contacts, newton
-    real(dp), intent(in) :: fcontact
+    real(dp), intent(in) :: fcontact, penetration
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: row(:)
     integer :: k, n
     if (.not. is_root()) return
     row = [st%t, real(st%step, dp), bal%kinetic, bal%strain, bal%work, bal%total, bal%p, bal%l, &
-           real(contacts, dp), fcontact, real(newton, dp)]
+           real(contacts, dp), fcontact, real(newton, dp), penetration]
     do k = 1, size(out%tracked)
       n = out%tracked(k)
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]

@@ -2,7 +2,7 @@
 !> to deck%problems with the deck's file name, the group's line and the field.
 module casca_sanity
   use casca_kinds, only: dp
-  use casca_deck, only: deck_t, add_problem, unset
+  use casca_deck, only: deck_t, add_problem, unset, deck_file
   implicit none
   private
   public :: check_deck, parse_fix
@@ -67,6 +67,8 @@ contains
         call positive(n, '&body '//trim(b%name)//': thickness', b%thickness)
         if (.not. (b%poisson > -1 .and. b%poisson < 0.5_dp)) call add_problem(deck, n, &
           '&body '//trim(b%name)//': poisson must be in (-1, 0.5)')
+        if (b%rotate_angle /= 0 .and. .not. norm2(b%rotate_axis) > 0) call add_problem(deck, n, &
+          '&body '//trim(b%name)//': rotate_axis must not be zero')
         select case (b%mesh)
         case ('ring')
           call positive(n, '&body '//trim(b%name)//': radius', b%radius)
@@ -82,12 +84,12 @@ contains
           if (b%nx < 1 .or. b%ny < 1) call add_problem(deck, n, '&body '//trim(b%name)// &
             ': nx and ny must be >= 1')
         case ('file')
-          inquire (file=deck%base_dir//trim(b%file), exist=exists)
+          inquire (file=deck_file(deck, b%file), exist=exists)
           if (b%file == '') then
             call add_problem(deck, n, '&body '//trim(b%name)//': mesh = ''file'' needs file = ...')
           else if (.not. exists) then
             call add_problem(deck, n, '&body '//trim(b%name)//': mesh file '''// &
-                             deck%base_dir//trim(b%file)//''' does not exist')
+                             deck_file(deck, b%file)//''' does not exist')
           end if
         case ('')
           call add_problem(deck, n, '&body '//trim(b%name)// &

@@ -6,7 +6,7 @@ module casca_scene
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_ring, mesh_sphere, mesh_plate
   use casca_gmsh_io, only: read_gmsh
-  use casca_deck, only: deck_t, add_problem
+  use casca_deck, only: deck_t, add_problem, deck_file
   use casca_sanity, only: parse_fix
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
   use casca_newmark, only: state_t
@@ -23,6 +23,7 @@ contains
     type(mesh_t), intent(out) :: mesh
     type(error_t), allocatable, intent(out) :: err
     integer :: i
+    real(dp) :: rot(3, 3)
     associate (b => deck%bodies(ib))
       select case (b%mesh)
       case ('ring')
@@ -32,14 +33,31 @@ contains
       case ('plate', 'strip')
         call mesh_plate(b%lx, b%ly, b%nx, b%ny, mesh, err)
       case ('file')
-        call read_gmsh(deck%base_dir//trim(b%file), mesh, err)
+        call read_gmsh(deck_file(deck, b%file), mesh, err)
       end select
       if (allocated(err)) return
+      rot = rotation(b%rotate_axis, b%rotate_angle*acos(-1._dp)/180)
       do i = 1, mesh%nnode
-        mesh%x(:, i) = mesh%x(:, i) + b%center
+        mesh%x(:, i) = matmul(rot, mesh%x(:, i)) + b%center
       end do
+      if (size(mesh%normal, 2) == mesh%nnode) mesh%normal = matmul(rot, mesh%normal)
     end associate
   end subroutine body_mesh
+
+  !> Rodrigues' rotation matrix (identity for a zero angle).
+  pure function rotation(axis, angle) result(r)
+    real(dp), intent(in) :: axis(3), angle
+    real(dp) :: r(3, 3), k(3, 3), n(3)
+    integer :: i
+    r = 0
+    do i = 1, 3
+      r(i, i) = 1
+    end do
+    if (angle == 0) return
+    n = axis/norm2(axis)
+    k = reshape([0._dp, n(3), -n(2), -n(3), 0._dp, n(1), n(2), -n(1), 0._dp], [3, 3])
+    r = r + sin(angle)*k + (1 - cos(angle))*matmul(k, k)
+  end function rotation
 
   subroutine build_model(deck, model)
     type(deck_t), intent(inout) :: deck

@@ -7,6 +7,7 @@ module casca_newmark
   use casca_assembly, only: assembly_t
   use casca_mumps_solver, only: sparse_solver_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
+  use casca_contact, only: contact_t, contact_persistency
   implicit none
   private
   public :: state_t, newmark_t, newmark_step, static_solve
@@ -24,8 +25,9 @@ module casca_newmark
 
 contains
 
-  !> One step s -> s+1 with external load fext (dead). On failure st is unchanged.
-  subroutine newmark_step(model, asm, solver, nm, fext, opts, st, rep, err)
+  !> One step s -> s+1 with external load fext (dead). On failure st and the contact's
+  !> active set are unchanged.
+  subroutine newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     type(sparse_solver_t), intent(inout) :: solver
@@ -35,8 +37,10 @@ contains
     type(state_t), intent(inout) :: st
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
+    type(contact_t), intent(inout), optional :: contact
     real(dp), allocatable :: qs(:), rs(:), q(:)
     real(dp) :: b, dt, g
+    type(contact_t), allocatable :: saved
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
     qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*st%qdd
@@ -44,15 +48,22 @@ contains
     ! predictor: the step taken with zero new acceleration
     q = st%q + dt*st%qd + dt*dt*(0.5_dp - b)*st%qdd
     where (model%fixed) q = st%q
-    call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs)
-    if (allocated(err)) return
-    if (.not. rep%converged) then
+    if (present(contact)) then
+      saved = contact
+      call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
+    else
+      call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs)
+    end if
+    if (.not. allocated(err) .and. .not. rep%converged) &
       call fatal_error(err, 'Newton did not converge')
+    if (allocated(err)) then
+      if (present(contact)) contact = saved
       return
     end if
     st%q = q
     st%qdd = q/(b*dt*dt) - qs
     st%qd = rs + g*dt*st%qdd
+    if (present(contact)) call contact_persistency(contact, model, st%qd, st%qdd)
     where (model%fixed)
       st%qd = 0; st%qdd = 0
     end where
@@ -61,7 +72,7 @@ contains
   end subroutine newmark_step
 
   !> Statics in nsteps equal load increments of fext; q holds the start and the result.
-  subroutine static_solve(model, asm, solver, fext, nsteps, opts, q, rep, err)
+  subroutine static_solve(model, asm, solver, fext, nsteps, opts, q, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     type(sparse_solver_t), intent(inout) :: solver
@@ -71,9 +82,11 @@ contains
     real(dp), intent(inout) :: q(:)
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
+    type(contact_t), intent(inout), optional :: contact
     integer :: i
     do i = 1, nsteps
-      call newton_solve(model, asm, solver, q, fext*(real(i, dp)/nsteps), opts, rep, err)
+      call newton_solve(model, asm, solver, q, fext*(real(i, dp)/nsteps), opts, rep, err, &
+                        contact=contact)
       if (allocated(err)) return
       if (.not. rep%converged) then
         call fatal_error(err, 'static Newton did not converge')

@@ -1,12 +1,16 @@
 !> Newton-Raphson on r(q) = f_int(q) [+ inertia] - f_ext = 0 with the analytic tangent,
-!> factorised by MUMPS. Convergence: the largest parameter increment, relative to the size
-!> of the scene, below tol.
+!> factorised by MUMPS. With contact, each iteration solves the saddle-point system
+!>     [ K  C^T ] [ dq     ]   [ -r ]
+!>     [ C  0   ] [ lambda ] = [ -g ]
+!> for the increment and the (total) multipliers. Convergence: the largest increment,
+!> relative to the size of the scene, below tol, with a settled active set.
 module casca_newton
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t
   use casca_assembly, only: assembly_t, assemble
   use casca_mumps_solver, only: sparse_solver_t
+  use casca_contact, only: contact_t, contact_update, contact_release, contact_rows
   use casca_mpi, only: is_root
   use casca_metis, only: nested_dissection
   implicit none
@@ -14,6 +18,7 @@ module casca_newton
   public :: newton_opts_t, newton_report_t, newton_solve
 
   integer, parameter :: max_hist = 100
+  integer, parameter :: max_set_changes = 12   !< active-set changes per step before settling
 
   type :: newton_opts_t
     real(dp) :: tol = 1e-10_dp   !< max |dq| / scene size
@@ -25,11 +30,13 @@ module casca_newton
     logical :: converged = .false.
     real(dp) :: incr(max_hist) = 0   !< max |dq| / scene size at each iteration
     real(dp) :: energy = 0           !< strain energy at the last assembled iterate
+    integer :: neg_pivots = 0        !< of the last factorisation (inertia)
+    integer :: analyses = 0          !< symbolic analyses done in this solve
   end type newton_report_t
 
 contains
 
-  subroutine newton_solve(model, asm, solver, q, fext, opts, rep, err, cm, qs)
+  subroutine newton_solve(model, asm, solver, q, fext, opts, rep, err, cm, qs, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     type(sparse_solver_t), intent(inout) :: solver
@@ -39,48 +46,103 @@ contains
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: cm, qs(:)
-    real(dp), allocatable :: r(:), x(:), b(:)
-    integer, allocatable :: perm(:)
-    integer :: it, i
+    type(contact_t), intent(inout), optional :: contact
+    real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:)
+    integer, allocatable :: cirn(:), cjcn(:)
+    integer :: it, i, nc, added, released
     real(dp) :: nrm
+    logical :: settled
 
-    allocate (r(model%ndof), x(asm%neq), b(asm%neq))
-    if (.not. solver%analysed) then
-      allocate (perm(0))
-      if (solver%ordering == 1 .and. is_root()) then
-        deallocate (perm); allocate (perm(asm%neq))
-        call nested_dissection(model%conn, model%nnode, asm%eq, asm%neq, perm, err)
-        if (allocated(err)) return
-      end if
-      call solver%analyse(asm%neq, asm%irn, asm%jcn, perm, err)
-      if (allocated(err)) return
-    end if
+    allocate (r(model%ndof))
+    if (present(contact)) contact%changes = 0
     do it = 1, min(opts%max_iter, max_hist)
       call assemble(model, asm, q, .true., r, rep%energy, cm, qs)
       r = r - fext
-      call solver%factorise(asm%a, err)
+      nc = 0
+      if (present(contact)) then
+        call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
+                            reproject=it <= 2)
+        nc = contact%nact
+        call contact_rows(contact, model, asm%eq, asm%neq, cirn, cjcn, cval, gap)
+      else
+        allocate (cirn(0), cjcn(0), cval(0), gap(0))
+      end if
+      call analyse_if_needed()
       if (allocated(err)) return
+      if (is_root()) then
+        call solver%factorise([asm%a, cval], err)
+      else
+        call solver%factorise(asm%a, err)
+      end if
+      if (allocated(err)) return
+      rep%neg_pivots = solver%negative_pivots()
+      allocate (b(asm%neq + nc), x(asm%neq + nc))
       if (is_root()) then
         do i = 1, model%ndof
           if (asm%eq(i) > 0) b(asm%eq(i)) = -r(i)
         end do
+        b(asm%neq + 1:) = -gap
       end if
       call solver%solve(b, x, err)
       if (allocated(err)) return
       do i = 1, model%ndof
         if (asm%eq(i) > 0) q(i) = q(i) + x(asm%eq(i))
       end do
-      nrm = maxval(abs(x))/model%length
+      if (nc > 0) contact%act(1:nc)%lambda = x(asm%neq + 1:)
+      nrm = maxval(abs(x(1:asm%neq)))/model%length
+      deallocate (b, x, cirn, cjcn, cval, gap)
       rep%iters = it
       rep%incr(it) = nrm
       if (.not. (nrm <= 1e6_dp)) then   ! also catches NaN
         call fatal_error(err, 'Newton iteration diverged')
         return
       end if
-      if (nrm <= opts%tol) then
+      if (nrm > opts%tol) cycle
+      settled = .true.
+      if (present(contact)) then
+        if (contact%changes < max_set_changes) then
+          ! converged for this set: release tensile multipliers, look for new penetrations
+          call contact_release(contact, released)
+          call contact_update(contact, model, q, .true., added, reproject=.false.)
+          settled = released == 0 .and. added == 0
+        end if
+      end if
+      if (settled) then
         rep%converged = .true.
         return
       end if
     end do
+  contains
+    !> symbolic analysis at the first solve and whenever the constraint rows change
+    subroutine analyse_if_needed()
+      integer, allocatable :: perm(:)
+      if (solver%analysed) then
+        if (.not. present(contact)) return
+        if (same_pattern()) return
+      end if
+      allocate (perm(0))
+      if (solver%ordering == 1 .and. is_root()) then
+        deallocate (perm); allocate (perm(asm%neq + nc))
+        call nested_dissection(model%conn, model%nnode, asm%eq, asm%neq, perm, err)
+        if (allocated(err)) return
+        perm(asm%neq + 1:) = [(asm%neq + i, i=1, nc)]   ! multipliers last
+      end if
+      if (is_root()) then
+        call solver%analyse(asm%neq + nc, [asm%irn, cirn], [asm%jcn, cjcn], perm, err)
+      else
+        call solver%analyse(asm%neq + nc, asm%irn, asm%jcn, perm, err)
+      end if
+      rep%analyses = rep%analyses + 1
+      if (present(contact)) then
+        contact%last_irn = cirn; contact%last_jcn = cjcn
+      end if
+    end subroutine analyse_if_needed
+
+    logical function same_pattern()
+      same_pattern = .false.
+      if (.not. allocated(contact%last_irn)) return
+      if (size(contact%last_irn) /= size(cirn)) return
+      same_pattern = all(contact%last_irn == cirn) .and. all(contact%last_jcn == cjcn)
+    end function same_pattern
   end subroutine newton_solve
 end module casca_newton

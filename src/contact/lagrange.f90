@@ -1,0 +1,394 @@
+!> Non-penetration by Lagrange multipliers (thesis ch. 5). For each pair (impactor body,
+!> target body), every impactor node whose signed distance to the target's sub-triangles is
+!> negative gets one multiplier lambda and the condition
+!>     g = (x_imp - x_target(xi)) . n(xi) = 0,   x_target = N_j(xi) Y^j of the cubic element,
+!> with n the unit normal of the cubic target at xi (eq. 5.4), linearised with xi and n held
+!> (eq. 5.6). lambda < 0 is compression (the contact force on the impactor is -lambda n); a
+!> multiplier that turns tensile at convergence is released.
+module casca_contact
+  use casca_kinds, only: dp
+  use casca_model, only: model_t, dof
+  use casca_shape_tri10, only: tri10_shape
+  use casca_surface_search, only: surface_t, grid_t, surface_init, grid_build, &
+                                  nearest_subtriangle, surface_box, subtri_parent_xi
+  implicit none
+  private
+  public :: contact_t, contact_init, contact_update, contact_release, contact_rows
+  public :: contact_penetration, contact_force_total, contact_nodal_fields, contact_signed_distance
+  public :: contact_persistency
+
+  type :: constraint_t
+    integer :: node = 0, pair = 0, elem = 0
+    real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
+    real(dp) :: gap = 0, lambda = 0
+    real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected
+  end type constraint_t
+
+  type :: contact_t
+    integer :: npairs = 0
+    integer, allocatable :: pair(:, :)          !< (2, npairs) impactor body, target body
+    type(surface_t), allocatable :: surf(:)     !< per body (only targets are built)
+    type(grid_t), allocatable :: grid(:)
+    logical, allocatable :: grid_ok(:)          !< grid of this body rebuilt for this q
+    real(dp), allocatable :: depth(:)           !< per body: deepest signed distance taken as penetration
+    real(dp) :: tol = 0                         !< penetration accepted [m]
+    integer :: nact = 0
+    type(constraint_t), allocatable :: act(:)
+    integer :: changes = 0                      !< active-set changes in this step
+    integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
+    real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
+  end type contact_t
+
+contains
+
+  !> pairs(2, npairs): impactor and target body of each pair. tol: accepted penetration [m].
+  subroutine contact_init(model, pairs, tol, c)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: pairs(:, :)
+    real(dp), intent(in) :: tol
+    type(contact_t), intent(out) :: c
+    integer :: b, e, k
+    real(dp) :: edge
+    c%npairs = size(pairs, 2)
+    c%pair = pairs
+    c%tol = tol
+    allocate (c%surf(model%nbody), c%grid(model%nbody), c%grid_ok(model%nbody), &
+              c%depth(model%nbody), c%act(16))
+    c%grid_ok = .false.; c%depth = 0
+    ! the mass a unit change of a node's velocity adds to the momentum: t^T M e_i
+    allocate (c%node_mass(model%nnode))
+    c%node_mass = 0
+    do e = 1, model%nelem
+      do k = 1, 10
+        c%node_mass(model%conn(k, e)) = c%node_mass(model%conn(k, e)) + sum(model%emass(1:10, k, e))
+      end do
+    end do
+    do b = 1, model%nbody
+      if (.not. any(pairs(2, :) == b)) cycle
+      associate (bd => model%body(b))
+        call surface_init(model%conn, [(e, e=bd%elem_first, bd%elem_last)], c%surf(b))
+        ! half the mean sub-triangle edge: a node deeper than that is behind the surface,
+        ! not through it (matters at the rim of open surfaces)
+        edge = 0
+        do k = 1, c%surf(b)%ntri
+          edge = edge + norm2(model%x0(:, c%surf(b)%tri(1, k)) - model%x0(:, c%surf(b)%tri(2, k)))
+        end do
+        c%depth(b) = 0.5_dp*edge/c%surf(b)%ntri
+      end associate
+    end do
+  end subroutine contact_init
+
+  !> Refresh the active constraints (normal and gap at their point; with reproject, the point
+  !> itself: nearest sub-triangle again) and, with detect, add the penetrating nodes that are
+  !> not yet active. Holding the point in late Newton iterations avoids flip-flopping between
+  !> two elements at a kink of the C0 surface. Returns the number of constraints added.
+  subroutine contact_update(c, model, q, detect, added, reproject)
+    type(contact_t), intent(inout) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    logical, intent(in) :: detect
+    integer, intent(out) :: added
+    logical, intent(in), optional :: reproject
+    real(dp), allocatable :: x(:, :)
+    real(dp) :: boxi(3, 2), boxt(3, 2), sd
+    integer :: ip, bi, bt, n, k
+    logical :: found
+    type(constraint_t) :: cn
+
+    added = 0
+    x = positions(model, q)
+    c%grid_ok = .false.
+    ! active constraints: project again (the target moves and the node slides)
+    do k = 1, c%nact
+      found = .false.
+      if (c%act(k)%elem > 0 .and. present(reproject)) then
+        if (.not. reproject) then
+          call finish(c%act(k)); cycle
+        end if
+      end if
+      call project(c%act(k)%node, c%act(k)%pair, cn, sd, found)
+      if (found) then
+        cn%lambda = c%act(k)%lambda
+        c%act(k) = cn
+      else   ! far from every sub-triangle within the band: keep the last projection
+        call finish(c%act(k))
+      end if
+    end do
+    if (.not. detect) return
+    do ip = 1, c%npairs
+      bi = c%pair(1, ip); bt = c%pair(2, ip)
+      boxi = box_of(bi); boxt = box_of(bt)
+      ! bodies whose boxes (the target's grown by the penetration band) are apart cost nothing
+      if (any(boxi(:, 1) > boxt(:, 2) + c%depth(bt)) .or. any(boxi(:, 2) < boxt(:, 1) - c%depth(bt))) cycle
+      do n = model%body(bi)%node_first, model%body(bi)%node_last
+        if (any(x(:, n) > boxt(:, 2) + c%depth(bt)) .or. any(x(:, n) < boxt(:, 1) - c%depth(bt))) cycle
+        if (is_active(n, ip)) cycle
+        call project(n, ip, cn, sd, found)
+        if (.not. found) cycle
+        if (sd < -c%tol .and. has_free_position(n, cn%elem)) then
+          call push(cn)
+          added = added + 1
+        end if
+      end do
+    end do
+    if (added > 0) c%changes = c%changes + 1
+  contains
+    function box_of(b) result(bx)
+      integer, intent(in) :: b
+      real(dp) :: bx(3, 2)
+      associate (bd => model%body(b))
+        bx(:, 1) = minval(x(:, bd%node_first:bd%node_last), dim=2)
+        bx(:, 2) = maxval(x(:, bd%node_first:bd%node_last), dim=2)
+      end associate
+    end function box_of
+
+    logical function is_active(node, p)
+      integer, intent(in) :: node, p
+      integer :: j
+      is_active = .false.
+      do j = 1, c%nact
+        if (c%act(j)%node == node .and. c%act(j)%pair == p) then
+          is_active = .true.; return
+        end if
+      end do
+    end function is_active
+
+    !> a constraint needs at least one free position on either side
+    logical function has_free_position(node, e)
+      integer, intent(in) :: node, e
+      has_free_position = .not. (all(model%fixed(dof(node, 1):dof(node, 3))) .and. &
+                            all(model%fixed(dof(model%conn(:, e), 1))) .and. &
+                            all(model%fixed(dof(model%conn(:, e), 2))) .and. &
+                            all(model%fixed(dof(model%conn(:, e), 3))))
+    end function has_free_position
+
+    !> signed distance of node to the target of pair p, and the constraint it would carry
+    subroutine project(node, p, con, sdist, ok)
+      integer, intent(in) :: node, p
+      type(constraint_t), intent(out) :: con
+      real(dp), intent(out) :: sdist
+      logical, intent(out) :: ok
+      integer :: b, itri, region
+      real(dp) :: xq(3), bary(3), dist, nt(3)
+      b = c%pair(2, p)
+      if (.not. c%grid_ok(b)) then
+        call grid_build(c%surf(b), x, c%grid(b))
+        c%grid_ok(b) = .true.
+      end if
+      call nearest_subtriangle(c%surf(b), c%grid(b), x, x(:, node), c%depth(b), ok, itri, xq, &
+                               bary, dist, region)
+      sdist = huge(1._dp)
+      if (.not. ok) return
+      associate (t => c%surf(b)%tri(:, itri))
+        nt = cross(x(:, t(2)) - x(:, t(1)), x(:, t(3)) - x(:, t(1)))
+      end associate
+      sdist = sign(dist, dot_product(x(:, node) - xq, nt))
+      con%sd = sdist
+      con%node = node; con%pair = p; con%elem = c%surf(b)%elem(itri)
+      call subtri_parent_xi(c%surf(b), itri, bary, con%xi)
+      call finish(con)
+    end subroutine project
+
+    !> shape functions, cubic normal and gap at the constraint's xi
+    subroutine finish(con)
+      type(constraint_t), intent(inout) :: con
+      real(dp) :: dphi(10, 2), t1(3), t2(3), xt(3)
+      call tri10_shape(con%xi(1), con%xi(2), con%shp, dphi)
+      xt = matmul(x(:, model%conn(:, con%elem)), con%shp)
+      t1 = matmul(x(:, model%conn(:, con%elem)), dphi(:, 1))
+      t2 = matmul(x(:, model%conn(:, con%elem)), dphi(:, 2))
+      con%n = cross(t1, t2)
+      con%n = con%n/norm2(con%n)
+      con%gap = dot_product(x(:, con%node) - xt, con%n)
+    end subroutine finish
+
+    subroutine push(con)
+      type(constraint_t), intent(in) :: con
+      type(constraint_t), allocatable :: tmp(:)
+      if (c%nact == size(c%act)) then
+        allocate (tmp(2*size(c%act)))
+        tmp(1:c%nact) = c%act(1:c%nact)
+        call move_alloc(tmp, c%act)
+      end if
+      c%nact = c%nact + 1
+      c%act(c%nact) = con
+    end subroutine push
+  end subroutine contact_update
+
+  !> Release the constraints whose multiplier is tensile (lambda > 0); how many were released.
+  subroutine contact_release(c, released)
+    type(contact_t), intent(inout) :: c
+    integer, intent(out) :: released
+    integer :: k, m
+    m = 0
+    do k = 1, c%nact
+      if (c%act(k)%lambda > 0) cycle
+      m = m + 1
+      c%act(m) = c%act(k)
+    end do
+    released = c%nact - m
+    c%nact = m
+    if (released > 0) c%changes = c%changes + 1
+  end subroutine contact_release
+
+  !> Constraint rows for MUMPS: entries (neq + k, eq) of dg_k/dq (irn > jcn), a zero
+  !> diagonal for each multiplier, and the gaps.
+  subroutine contact_rows(c, model, eq, neq, irn, jcn, val, gap)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: eq(:), neq
+    integer, allocatable, intent(out) :: irn(:), jcn(:)
+    real(dp), allocatable, intent(out) :: val(:), gap(:)
+    integer :: k, j, comp, m, e
+    allocate (irn(34*c%nact), jcn(34*c%nact), val(34*c%nact), gap(c%nact))
+    m = 0
+    do k = 1, c%nact
+      associate (a => c%act(k))
+        gap(k) = a%gap
+        do comp = 1, 3
+          call put(neq + k, eq(dof(a%node, comp)), a%n(comp))
+          do j = 1, 10
+            e = model%conn(j, a%elem)
+            call put(neq + k, eq(dof(e, comp)), -a%shp(j)*a%n(comp))
+          end do
+        end do
+        m = m + 1; irn(m) = neq + k; jcn(m) = neq + k; val(m) = 0
+      end associate
+    end do
+    irn = irn(1:m); jcn = jcn(1:m); val = val(1:m)
+  contains
+    subroutine put(i, j2, v)
+      integer, intent(in) :: i, j2
+      real(dp), intent(in) :: v
+      if (j2 == 0) return   ! prescribed parameter: no column
+      m = m + 1; irn(m) = i; jcn(m) = j2; val(m) = v
+    end subroutine put
+  end subroutine contact_rows
+
+  !> Persistent contact after a converged step (Taylor & Papadopoulos 1993): the normal
+  !> relative velocity and acceleration of each constraint are removed by an impulse on the
+  !> impactor node and the opposite impulse spread over the target nodes by N_j, so that the
+  !> momentum t^T M v stays exactly as it was. Without it the trapezoidal rule turns the
+  !> position constraint into a velocity that flips sign every step, and gains energy.
+  subroutine contact_persistency(c, model, qd, qdd)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(inout) :: qd(:), qdd(:)
+    integer :: k
+    do k = 1, c%nact
+      call remove_normal(qd, c%act(k))
+      call remove_normal(qdd, c%act(k))
+    end do
+  contains
+    subroutine remove_normal(v, a)
+      real(dp), intent(inout) :: v(:)
+      type(constraint_t), intent(in) :: a
+      real(dp) :: w, flex, p
+      integer :: j, nd
+      logical :: free_i
+      free_i = .not. any(model%fixed(dof(a%node, 1):dof(a%node, 3)))
+      w = dot_product(v(dof(a%node, 1):dof(a%node, 3)), a%n)
+      flex = 0
+      if (free_i) flex = 1/c%node_mass(a%node)
+      do j = 1, 10
+        nd = model%conn(j, a%elem)
+        w = w - a%shp(j)*dot_product(v(dof(nd, 1):dof(nd, 3)), a%n)
+        if (.not. any(model%fixed(dof(nd, 1):dof(nd, 3)))) flex = flex + a%shp(j)**2/c%node_mass(nd)
+      end do
+      if (flex <= 0) return
+      p = -w/flex
+      if (free_i) v(dof(a%node, 1):dof(a%node, 3)) = v(dof(a%node, 1):dof(a%node, 3)) &
+                                                       + (p/c%node_mass(a%node))*a%n
+      do j = 1, 10
+        nd = model%conn(j, a%elem)
+        if (any(model%fixed(dof(nd, 1):dof(nd, 3)))) cycle
+        v(dof(nd, 1):dof(nd, 3)) = v(dof(nd, 1):dof(nd, 3)) - (p*a%shp(j)/c%node_mass(nd))*a%n
+      end do
+    end subroutine remove_normal
+  end subroutine contact_persistency
+
+  !> Deepest penetration of the impactor nodes that carry no constraint (signed distance to
+  !> the sub-triangles) and largest |gap| of those that do.
+  subroutine contact_penetration(c, model, q, free_pen, max_gap)
+    type(contact_t), intent(inout) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    real(dp), intent(out) :: free_pen, max_gap
+    type(contact_t) :: probe
+    integer :: added, k
+    ! a copy with no active constraint and zero tolerance detects every penetrating node
+    probe = c
+    probe%tol = 0; probe%nact = 0
+    call contact_update(probe, model, q, .true., added, .false.)
+    free_pen = 0
+    do k = 1, probe%nact
+      if (any(c%act(1:c%nact)%node == probe%act(k)%node .and. &
+              c%act(1:c%nact)%pair == probe%act(k)%pair)) cycle
+      free_pen = max(free_pen, -probe%act(k)%sd)
+    end do
+    max_gap = 0
+    if (c%nact > 0) max_gap = maxval(abs(c%act(1:c%nact)%gap))
+  end subroutine contact_penetration
+
+  !> Signed distance of every impactor node to its target (the band's depth where farther,
+  !> 0 for nodes that impact nothing), for output.
+  subroutine contact_signed_distance(c, model, q, sd)
+    type(contact_t), intent(inout) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    real(dp), intent(out) :: sd(:)
+    type(contact_t) :: probe
+    integer :: added, k, ip, b
+    sd = 0
+    do ip = 1, c%npairs
+      b = c%pair(1, ip)
+      sd(model%body(b)%node_first:model%body(b)%node_last) = c%depth(c%pair(2, ip))
+    end do
+    ! every node inside the band, penetrating or not: a probe that takes any distance
+    probe = c
+    probe%nact = 0; probe%tol = -huge(1._dp)
+    call contact_update(probe, model, q, .true., added, .false.)
+    do k = 1, probe%nact
+      sd(probe%act(k)%node) = min(sd(probe%act(k)%node), probe%act(k)%sd)
+    end do
+  end subroutine contact_signed_distance
+
+  !> Total normal contact force (sum of the compressive multipliers).
+  pure real(dp) function contact_force_total(c)
+    type(contact_t), intent(in) :: c
+    contact_force_total = -sum(c%act(1:c%nact)%lambda)
+  end function contact_force_total
+
+  !> Nodal contact force (3, nnode) on both sides, for output.
+  pure subroutine contact_nodal_fields(c, model, force)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(out) :: force(:, :)
+    integer :: k, j
+    force = 0
+    do k = 1, c%nact
+      associate (a => c%act(k))
+        force(:, a%node) = force(:, a%node) - a%lambda*a%n
+        do j = 1, 10
+          force(:, model%conn(j, a%elem)) = force(:, model%conn(j, a%elem)) + a%lambda*a%shp(j)*a%n
+        end do
+      end associate
+    end do
+  end subroutine contact_nodal_fields
+
+  pure function positions(model, q) result(x)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    real(dp) :: x(3, model%nnode)
+    integer :: n
+    do n = 1, model%nnode
+      x(:, n) = q(dof(n, 1):dof(n, 3))
+    end do
+  end function positions
+
+  pure function cross(a, b) result(v)
+    real(dp), intent(in) :: a(3), b(3)
+    real(dp) :: v(3)
+    v = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+  end function cross
+end module casca_contact
