@@ -3,9 +3,9 @@
 module casca_run
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_deck, only: deck_t, read_deck, unset
+  use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
-  use casca_scene, only: build_model, initial_state, tracked_nodes
+  use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs
   use casca_model, only: model_t, reference_state
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_mumps_solver, only: sparse_solver_t
@@ -15,10 +15,11 @@ module casca_run
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close
   use casca_vtu_writer, only: field_t, field
   use casca_contact, only: contact_t, contact_init, contact_force_total, contact_nodal_fields, &
-                           contact_penetration, contact_signed_distance
+                           contact_penetration, contact_signed_distance, contact_update
   use casca_hdf5_io, only: write_checkpoint, read_checkpoint
   use casca_plots, only: make_plots
   use casca_mpi, only: is_root, wall_time, n_ranks
+  use casca_timers, only: timer_start, timer_stop, timer_report, t_account, t_output
   implicit none
   private
   public :: load_scene, run_deck
@@ -37,6 +38,7 @@ contains
     call read_deck(path, deck)
     if (deck%nproblems == 0) call check_deck(deck)
     if (deck%nproblems == 0) call build_model(deck, model)
+    if (deck%nproblems == 0) call check_overlap()
     code = exit_ok
     if (deck%nproblems > 0) then
       if (is_root()) then
@@ -47,6 +49,30 @@ contains
       end if
       code = exit_input
     end if
+  contains
+    !> bodies of a contact pair that overlap at the start are refused, never ignored
+    subroutine check_overlap()
+      type(contact_t) :: probe
+      real(dp), allocatable :: q(:)
+      integer, allocatable :: pairs(:, :)
+      integer :: added, k, worst
+      character(len=256) :: msg
+      pairs = contact_pairs(deck, model)
+      if (size(pairs, 2) == 0) return
+      call contact_init(model, pairs, deck%contact%tolerance*model%length, probe)
+      allocate (q(model%ndof))
+      call reference_state(model, q)
+      call contact_update(probe, model, q, .true., added)
+      if (added == 0) return
+      worst = minloc(probe%act(1:probe%nact)%sd, dim=1)
+      k = probe%act(worst)%node
+      write (msg, '(a,a,a,a,a,i0,a,es10.3,a,i0,a)') 'bodies ''', &
+        trim(model%body(model%node_body(k))%name), ''' and ''', &
+        trim(model%body(pairs(2, probe%act(worst)%pair))%name), ''' overlap at the start: node ', &
+        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%sd, &
+        ' m inside (', added, ' nodes in all); move them apart'
+      call add_problem(deck, 0, trim(msg))
+    end subroutine check_overlap
   end subroutine load_scene
 
   subroutine run_deck(path, out_dir, restart, quiet, code)
@@ -173,11 +199,17 @@ contains
       end if
       total_newton = total_newton + rep%iters
       if (level > 0 .and. rep%iters <= 3) level = level - 1   ! Newton is at ease: grow back
+      call timer_start(t_account)
       call account(model, asm, st, fext, q0, bal)
+      call timer_stop(t_account)
+      call timer_start(t_output)
       call history_row(rep%iters)
+      call timer_stop(t_output)
       if (failed('history')) return
       if (st%t >= next_frame - 1e-9_dp*dt .or. st%t >= deck%run%t_end - 1e-9_dp*dt) then
+        call timer_start(t_output)
         call frame()
+        call timer_stop(t_output)
         if (failed('frame')) return
         next_frame = next_frame + interval
         if (is_root() .and. .not. quiet) call progress()
@@ -194,29 +226,11 @@ contains
 
   contains
 
-    !> contact pairs of the deck (default: every pair of bodies, the earlier one impacting)
     subroutine setup_contact()
       integer, allocatable :: pairs(:, :)
-      integer :: i, j, p
-      use_contact = deck%contact%enabled .and. model%nbody > 1
-      if (.not. use_contact) return
-      if (deck%contact%npairs > 0) then
-        allocate (pairs(2, deck%contact%npairs))
-        do p = 1, deck%contact%npairs
-          do j = 1, 2
-            pairs(j, p) = findloc([(model%body(i)%name == deck%contact%pairs(j, p), &
-                                    i=1, model%nbody)], .true., dim=1)
-          end do
-        end do
-      else
-        allocate (pairs(2, 0))
-        do i = 1, model%nbody
-          do j = i + 1, model%nbody
-            pairs = reshape([pairs, i, j], [2, size(pairs, 2) + 1])
-          end do
-        end do
-      end if
-      call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
+      pairs = contact_pairs(deck, model)
+      use_contact = size(pairs, 2) > 0
+      if (use_contact) call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
     end subroutine setup_contact
 
     subroutine history_row(newton)
@@ -225,9 +239,9 @@ contains
       if (use_contact) then
         call contact_penetration(contact, model, st%q, pen, gmax)
         call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
-                            max(pen, 0._dp), err)
+                            max(pen, 0._dp), rep%neg_pivots, err)
       else
-        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, err)
+        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, err)
       end if
     end subroutine history_row
 
@@ -307,8 +321,11 @@ contains
         if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//dir// &
           '/plots.gp was written but not run'
       end if
-      if (is_root() .and. .not. quiet) print '(a,i0,a,f0.2,a,a)', 'done: ', st%step, &
-        ' steps in ', wall_time() - t0, ' s; results in ', dir
+      if (is_root() .and. .not. quiet) then
+        print '(a,i0,a,f0.2,a,a)', 'done: ', st%step, ' steps in ', wall_time() - t0, &
+          ' s; results in ', dir
+        print '(a)', timer_report(wall_time() - t0)
+      end if
     end subroutine finish
 
     !> Statics: load steps of the dead loads; one history row and frame per load step

@@ -10,6 +10,7 @@
 module casca_deck
   use, intrinsic :: iso_fortran_env, only: iostat_end
   use casca_kinds, only: dp
+  use casca_deck_lint, only: lint_group
   implicit none
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
@@ -273,10 +274,11 @@ contains
     character(len=16), allocatable, intent(out) :: gname(:)
     integer, allocatable, intent(out) :: gline(:)
     character(len=1024) :: line
+    character(len=1024), allocatable :: text(:)
     character(len=16) :: name
-    integer :: ios, n, j
+    integer :: ios, n, j, k
 
-    allocate (gname(0), gline(0))
+    allocate (gname(0), gline(0), text(0))
     n = 0
     do
       read (u, '(a)', iostat=ios) line
@@ -285,6 +287,7 @@ contains
         call add_problem(deck, n + 1, 'unreadable line'); exit
       end if
       n = n + 1
+      text = [text, line]
       line = adjustl(line)
       if (line(1:1) /= '&') cycle
       j = scan(line(2:), ' /,'//achar(9))
@@ -299,6 +302,15 @@ contains
       gname = [gname, name]; gline = [gline, n]
     end do
     rewind (u)
+    do k = 1, size(gname)
+      call lint_group(text, gline(k), trim(gname(k)), report)
+    end do
+  contains
+    subroutine report(line_no, msg)
+      integer, intent(in) :: line_no
+      character(len=*), intent(in) :: msg
+      call add_problem(deck, line_no, msg)
+    end subroutine report
   end subroutine scan_groups
 
   subroutine read_run(u, deck, line)

@@ -39,7 +39,7 @@ contains
     character(len=8) :: p
     integer :: k, c
     cols = [character(len=16) :: 't', 'step', 'kinetic', 'strain', 'work', 'total', 'px', 'py', &
-            'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton', 'penetration']
+            'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton', 'penetration', 'neg_pivots']
     do k = 1, ntrack
       write (p, '(a,i0)') 'p', k
       do c = 1, 6
@@ -158,19 +158,20 @@ contains
   end subroutine output_open
 
   !> One row: time, energies, momenta, contacts, Newton iterations, deepest penetration of a
-  !> node without constraint, tracked nodes.
-  subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, err)
+  !> node without constraint, negative pivots of the last factorisation (the inertia of the
+  !> saddle-point matrix: one per active constraint), tracked nodes.
+  subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, err)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
-    integer, intent(in) :: contacts, newton
+    integer, intent(in) :: contacts, newton, neg_pivots
     real(dp), intent(in) :: fcontact, penetration
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: row(:)
     integer :: k, n
     if (.not. is_root()) return
     row = [st%t, real(st%step, dp), bal%kinetic, bal%strain, bal%work, bal%total, bal%p, bal%l, &
-           real(contacts, dp), fcontact, real(newton, dp), penetration]
+           real(contacts, dp), fcontact, real(newton, dp), penetration, real(neg_pivots, dp)]
     do k = 1, size(out%tracked)
       n = out%tracked(k)
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]

@@ -12,7 +12,7 @@ module casca_scene
   use casca_newmark, only: state_t
   implicit none
   private
-  public :: build_model, initial_state, tracked_nodes, body_mesh
+  public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs
 
 contains
 
@@ -146,6 +146,32 @@ contains
       end if
     end function body_label
   end subroutine build_model
+
+  !> Contact pairs (impactor, target) of the deck: those it lists, or every pair of bodies
+  !> with the earlier one impacting. None when contact is off or there is one body.
+  function contact_pairs(deck, model) result(pairs)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    integer, allocatable :: pairs(:, :)
+    integer :: i, j, p
+    allocate (pairs(2, 0))
+    if (.not. deck%contact%enabled .or. model%nbody < 2) return
+    if (deck%contact%npairs > 0) then
+      deallocate (pairs); allocate (pairs(2, deck%contact%npairs))
+      do p = 1, deck%contact%npairs
+        do j = 1, 2
+          pairs(j, p) = findloc([(model%body(i)%name == deck%contact%pairs(j, p), &
+                                  i=1, model%nbody)], .true., dim=1)
+        end do
+      end do
+    else
+      do i = 1, model%nbody
+        do j = i + 1, model%nbody
+          pairs = reshape([pairs, i, j], [2, size(pairs, 2) + 1])
+        end do
+      end do
+    end if
+  end function contact_pairs
 
   !> Unstressed initial state moving with each body's velocity and spin (about its centroid).
   subroutine initial_state(deck, model, st)

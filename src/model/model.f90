@@ -129,7 +129,9 @@ contains
     end do
     do i = 1, model%nnode
       if (norm2(model%v0(:, i)) <= 0) then
-        write (msg, '(a,i0,a)') 'node ', i, ' has no normal (degenerate elements around it)'
+        write (msg, '(a,i0,a,a,a)') 'node ', i - model%body(model%node_body(i))%node_first + 1, &
+          ' of body "', model%body(model%node_body(i))%name, &
+          '" has no normal: the elements around it are degenerate (zero area)'
         call fatal_error(err, trim(msg)); return
       end if
       model%v0(:, i) = model%v0(:, i)/norm2(model%v0(:, i))

@@ -12,6 +12,13 @@ module casca_mumps_solver
 
   include 'dmumps_struc.h'
 
+  interface   ! MUMPS ships no module: the one entry point, declared here
+    subroutine dmumps(id)
+      import :: dmumps_struc
+      type(dmumps_struc), intent(inout) :: id
+    end subroutine dmumps
+  end interface
+
   type :: sparse_solver_t
     type(dmumps_struc), private :: id
     logical :: started = .false.

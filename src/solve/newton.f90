@@ -13,6 +13,8 @@ module casca_newton
   use casca_contact, only: contact_t, contact_update, contact_release, contact_rows
   use casca_mpi, only: is_root
   use casca_metis, only: nested_dissection
+  use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
+                          t_solve
   implicit none
   private
   public :: newton_opts_t, newton_report_t, newton_solve
@@ -56,9 +58,12 @@ contains
     allocate (r(model%ndof))
     if (present(contact)) contact%changes = 0
     do it = 1, min(opts%max_iter, max_hist)
+      call timer_start(t_assembly)
       call assemble(model, asm, q, .true., r, rep%energy, cm, qs)
       r = r - fext
+      call timer_stop(t_assembly)
       nc = 0
+      call timer_start(t_contact)
       if (present(contact)) then
         call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
                             reproject=it <= 2)
@@ -67,13 +72,18 @@ contains
       else
         allocate (cirn(0), cjcn(0), cval(0), gap(0))
       end if
+      call timer_stop(t_contact)
+      call timer_start(t_analysis)
       call analyse_if_needed()
+      call timer_stop(t_analysis)
       if (allocated(err)) return
+      call timer_start(t_factor)
       if (is_root()) then
         call solver%factorise([asm%a, cval], err)
       else
         call solver%factorise(asm%a, err)
       end if
+      call timer_stop(t_factor)
       if (allocated(err)) return
       rep%neg_pivots = solver%negative_pivots()
       allocate (b(asm%neq + nc), x(asm%neq + nc))
@@ -83,7 +93,9 @@ contains
         end do
         b(asm%neq + 1:) = -gap
       end if
+      call timer_start(t_solve)
       call solver%solve(b, x, err)
+      call timer_stop(t_solve)
       if (allocated(err)) return
       do i = 1, model%ndof
         if (asm%eq(i) > 0) q(i) = q(i) + x(asm%eq(i))
@@ -102,8 +114,10 @@ contains
       if (present(contact)) then
         if (contact%changes < max_set_changes) then
           ! converged for this set: release tensile multipliers, look for new penetrations
+          call timer_start(t_contact)
           call contact_release(contact, released)
           call contact_update(contact, model, q, .true., added, reproject=.false.)
+          call timer_stop(t_contact)
           settled = released == 0 .and. added == 0
         end if
       end if

@@ -1,0 +1,257 @@
+!> A light reading of namelist groups before Fortran's own reader sees them: every key must
+!> be one the group knows and every value of the right type. gfortran's messages for these
+!> mistakes ("Cannot match namelist object name 'abc'") do not name the field; these do.
+module casca_deck_lint
+  implicit none
+  private
+  public :: lint_group, key_type
+
+contains
+
+  !> Type of key in group: 'r' real, 'i' integer, 'l' logical, 's' string, ' ' unknown.
+  pure function key_type(group, key) result(t)
+    character(len=*), intent(in) :: group, key
+    character(len=1) :: t
+    t = ' '
+    select case (group)
+    case ('run')
+      select case (key)
+      case ('title', 'analysis', 'ordering'); t = 's'
+      case ('dt', 't_end', 'beta', 'gamma', 'newton_tol', 'gravity'); t = 'r'
+      case ('newton_max_iter', 'load_steps', 'max_step_cuts'); t = 'i'
+      end select
+    case ('output')
+      select case (key)
+      case ('dir', 'track_body'); t = 's'
+      case ('interval', 'checkpoint_interval', 'track'); t = 'r'
+      case ('vtu', 'plots'); t = 'l'
+      end select
+    case ('body')
+      select case (key)
+      case ('name', 'mesh', 'file'); t = 's'
+      case ('radius', 'width', 'lx', 'ly', 'center', 'rotate_axis', 'rotate_angle', 'young', &
+            'poisson', 'density', 'thickness', 'velocity', 'omega'); t = 'r'
+      case ('n_around', 'n_across', 'n_div', 'nx', 'ny'); t = 'i'
+      end select
+    case ('restraint')
+      select case (key)
+      case ('body', 'fix'); t = 's'
+      case ('box_min', 'box_max'); t = 'r'
+      end select
+    case ('load')
+      select case (key)
+      case ('body'); t = 's'
+      case ('box_min', 'box_max', 'force'); t = 'r'
+      end select
+    case ('contact')
+      select case (key)
+      case ('pairs'); t = 's'
+      case ('tolerance'); t = 'r'
+      case ('enabled'); t = 'l'
+      end select
+    end select
+  end function key_type
+
+  !> Check the group whose '&name' is on line first of text(:). Each problem is returned as
+  !> (line, message) through report.
+  subroutine lint_group(text, first, group, report)
+    character(len=*), intent(in) :: text(:), group
+    integer, intent(in) :: first
+    interface
+      subroutine report(line, msg)
+        integer, intent(in) :: line
+        character(len=*), intent(in) :: msg
+      end subroutine report
+    end interface
+    character(len=:), allocatable :: s, key, item
+    integer, allocatable :: lineof(:)
+    integer :: i, j, k, n, p
+    character(len=1) :: t, q
+    logical :: done
+
+    ! the group as one string (comments cut), with the line of each character
+    s = ''
+    allocate (lineof(0))
+    do i = first, size(text)
+      k = comment_start(text(i))
+      s = s//text(i)(1:k - 1)//' '
+      lineof = [lineof, spread(i, 1, k)]
+      if (group_ends(s)) exit
+    end do
+    n = len(s)
+    p = index(s, '&') + 1 + len_trim(group)
+    key = ''; t = ' '
+    done = .false.
+    do while (p <= n .and. .not. done)
+      select case (s(p:p))
+      case (' ', ',', achar(9))
+        p = p + 1
+      case ('/')
+        done = .true.
+      case ("'", '"')
+        q = s(p:p)
+        j = index(s(p + 1:), q)
+        if (j == 0) j = n - p
+        call value(s(p:p + j), lineof(p))
+        p = p + j + 1
+      case default
+        j = p
+        do while (j <= n)
+          if (index(' ,/=', s(j:j)) > 0 .or. s(j:j) == achar(9)) exit
+          j = j + 1
+        end do
+        item = s(p:j - 1)
+        k = j
+        do while (k <= n)
+          if (s(k:k) /= ' ') exit
+          k = k + 1
+        end do
+        if (k <= n .and. s(k:k) == '=') then   ! a key
+          key = lower(item)
+          if (index(key, '(') > 0) key = key(1:index(key, '(') - 1)
+          t = key_type(group, key)
+          if (t == ' ') call report(lineof(p), '&'//group//': unknown key '''//key//''''// &
+                                    suggestion(key))
+          p = k + 1
+        else
+          call value(item, lineof(p))
+          p = j
+        end if
+      end select
+    end do
+  contains
+    subroutine value(v, line)
+      character(len=*), intent(in) :: v
+      integer, intent(in) :: line
+      character(len=:), allocatable :: w
+      integer :: ios, iv, star
+      real :: rv
+      logical :: lv
+      if (key == '' .or. t == ' ') return
+      w = v
+      star = index(w, '*')   ! repeat count r*value
+      if (star > 0 .and. verify(w(1:max(star - 1, 1)), '0123456789') == 0) w = w(star + 1:)
+      if (len(w) == 0) return
+      ios = 0
+      select case (t)
+      case ('s')
+        if (w(1:1) /= "'" .and. w(1:1) /= '"') ios = 1
+      case ('r')
+        if (w(1:1) == "'" .or. w(1:1) == '"' .or. w(1:1) == '.') then
+          if (verify(w(1:1), '.') == 0 .and. verify(w(2:2), '0123456789') == 0 .and. len(w) > 1) then
+            read (w, *, iostat=ios) rv
+          else
+            ios = 1
+          end if
+        else
+          read (w, *, iostat=ios) rv
+        end if
+      case ('i')
+        if (verify(w, '+-0123456789') /= 0) ios = 1
+        if (ios == 0) read (w, *, iostat=ios) iv
+      case ('l')
+        select case (lower(w))
+        case ('.true.', '.false.', 't', 'f', '.t.', '.f.')
+          lv = .true.
+        case default
+          ios = 1
+        end select
+      end select
+      if (ios /= 0) call report(line, '&'//group//': '//key//' = '//w//' is not '//kind_name(t))
+    end subroutine value
+  end subroutine lint_group
+
+  pure function kind_name(t) result(s)
+    character(len=1), intent(in) :: t
+    character(len=:), allocatable :: s
+    select case (t)
+    case ('r'); s = 'a number'
+    case ('i'); s = 'an integer'
+    case ('l'); s = 'a logical (.true. or .false.)'
+    case default; s = 'a quoted string'
+    end select
+  end function kind_name
+
+  !> where a '!' comment starts outside quotes (len+1 if none)
+  pure integer function comment_start(line)
+    character(len=*), intent(in) :: line
+    character(len=1) :: q
+    integer :: i
+    q = ' '
+    comment_start = len_trim(line) + 1
+    do i = 1, len_trim(line)
+      if (q /= ' ') then
+        if (line(i:i) == q) q = ' '
+      else if (line(i:i) == "'" .or. line(i:i) == '"') then
+        q = line(i:i)
+      else if (line(i:i) == '!') then
+        comment_start = i; return
+      end if
+    end do
+  end function comment_start
+
+  !> the text holds a '/' outside quotes (end of the group)
+  pure logical function group_ends(s)
+    character(len=*), intent(in) :: s
+    character(len=1) :: q
+    integer :: i
+    q = ' '
+    group_ends = .false.
+    do i = 1, len(s)
+      if (q /= ' ') then
+        if (s(i:i) == q) q = ' '
+      else if (s(i:i) == "'" .or. s(i:i) == '"') then
+        q = s(i:i)
+      else if (s(i:i) == '/') then
+        group_ends = .true.; return
+      end if
+    end do
+  end function group_ends
+
+  !> ' (did you mean ''x''?)' for the nearest known key of any group, by edit distance
+  function suggestion(key) result(s)
+    character(len=*), intent(in) :: key
+    character(len=:), allocatable :: s
+    character(len=*), parameter :: all_keys(*) = [character(len=19) :: 'title', 'analysis', &
+      'ordering', 'dt', 't_end', 'beta', 'gamma', 'newton_tol', 'gravity', 'newton_max_iter', &
+      'load_steps', 'max_step_cuts', 'dir', 'track_body', 'interval', 'checkpoint_interval', &
+      'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
+      'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
+      'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &
+      'force', 'pairs', 'tolerance', 'enabled']
+    integer :: i, d, best
+    s = ''
+    best = 3
+    do i = 1, size(all_keys)
+      d = edit_distance(key, trim(all_keys(i)))
+      if (d < best) then
+        best = d; s = ' (did you mean '''//trim(all_keys(i))//'''?)'
+      end if
+    end do
+  end function suggestion
+
+  pure integer function edit_distance(a, b) result(d)
+    character(len=*), intent(in) :: a, b
+    integer :: row(0:len(b)), prev, tmp, i, j
+    row = [(j, j=0, len(b))]
+    do i = 1, len(a)
+      prev = row(0); row(0) = i
+      do j = 1, len(b)
+        tmp = row(j)
+        row(j) = min(row(j) + 1, row(j - 1) + 1, prev + merge(0, 1, a(i:i) == b(j:j)))
+        prev = tmp
+      end do
+    end do
+    d = row(len(b))
+  end function edit_distance
+
+  pure function lower(s) result(t)
+    character(len=*), intent(in) :: s
+    character(len=len(s)) :: t
+    integer :: i
+    t = s
+    do i = 1, len(s)
+      if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
+    end do
+  end function lower
+end module casca_deck_lint

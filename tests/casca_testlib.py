@@ -1,0 +1,71 @@
+"""Helpers shared by the end-to-end tests: run casca, read its history, record checks.
+
+Every check prints its figure, the bound and the independent answer; the script ends with
+the "N passed, M failed" line and a non-zero exit status if anything failed."""
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+           OMPI_MCA_rmaps_base_oversubscribe="1")
+
+
+class Checks:
+    def __init__(self):
+        self.passed = 0
+        self.failed = 0
+
+    def record(self, name, ok, detail=""):
+        if ok:
+            self.passed += 1
+        else:
+            self.failed += 1
+        print(("PASS " if ok else "FAIL ") + name + (": " + detail if detail else ""), flush=True)
+
+    def le(self, name, value, bound):
+        self.record(name, value <= bound, "%.6g <= %.6g" % (value, bound))
+
+    def close(self, name, value, expected, rtol):
+        self.record(name, abs(value - expected) <= rtol * abs(expected),
+                    "%.6g vs %.6g (rtol %.3g, off by %.3g%%)"
+                    % (value, expected, rtol, 100 * abs(value - expected) / abs(expected)))
+
+    def finish(self):
+        print("%d passed, %d failed" % (self.passed, self.failed))
+        sys.exit(1 if self.failed else 0)
+
+
+def run(args, np_ranks=1, cwd=None, timeout=3000):
+    """Run casca (args[0] is the binary) on np_ranks ranks; returns the CompletedProcess."""
+    cmd = list(args)
+    if np_ranks > 1:
+        cmd = ["mpirun", "-np", str(np_ranks)] + cmd
+    return subprocess.run(cmd, cwd=cwd, env=ENV, capture_output=True, text=True, timeout=timeout)
+
+
+def history(folder):
+    """history.dat as a dict of columns (numpy arrays), keyed by the header's names."""
+    path = os.path.join(folder, "history.dat")
+    with open(path) as f:
+        names = f.readline().lstrip("#").split()
+    data = np.atleast_2d(np.loadtxt(path))
+    return {n: data[:, i] for i, n in enumerate(names)}
+
+
+def deck_variant(src, dst, **changes):
+    """Copy a deck, replacing `key = value` assignments (first occurrence of each key) and
+    making relative mesh paths absolute so the copy can live elsewhere."""
+    text = open(src).read()
+    base = os.path.dirname(os.path.abspath(src))
+    text = re.sub(r"file\s*=\s*'([^'/][^']*)'",
+                  lambda m: "file = '%s'" % os.path.normpath(os.path.join(base, m.group(1))), text)
+    for key, value in changes.items():
+        text, n = re.subn(r"\b%s\s*=\s*[^,\n/]+" % key, "%s = %s" % (key, value), text, count=1)
+        if n == 0:
+            raise ValueError("%s has no %s" % (src, key))
+    with open(dst, "w") as f:
+        f.write(text)
+    return dst

@@ -1,0 +1,203 @@
+"""The command line, the deck checks and the output files (issue: scenes in, results out).
+
+usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
+"""
+import glob
+import os
+import re
+import shutil
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import meshio
+import numpy as np
+
+from casca_testlib import Checks, deck_variant, history, run
+
+casca, examples, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:5]]
+os.makedirs(work, exist_ok=True)
+ck = Checks()
+
+# --- the command line itself
+p = run([casca, "--help"])
+ck.record("casca --help: exit 0 and usage", p.returncode == 0 and "casca run DECK" in p.stdout)
+p = run([casca, "--version"])
+ck.record("casca --version", p.returncode == 0 and re.match(r"casca \d+\.\d+\.\d+", p.stdout) is not None)
+p = run([casca, "frobnicate"])
+ck.record("unknown command: exit 2", p.returncode == 2 and "unknown command" in p.stderr)
+p = run([casca, "run"])
+ck.record("run without a deck: exit 2", p.returncode == 2 and "no deck" in p.stderr)
+for deck in sorted(glob.glob(os.path.join(examples, "*.nml"))):
+    p = run([casca, "check", deck])
+    ck.record("casca check %s: exit 0" % os.path.basename(deck), p.returncode == 0, p.stderr[-200:])
+
+# --- malformed decks: exit 2, a message naming the file, the line or group, and the field
+ring = os.path.join(meshdir, "ring_20x1.msh")
+good = """&run
+  dt = 5.0e-5, t_end = 3.0e-3
+/
+&output
+  interval = 5.0e-4
+  track = 1.0, 0.0, 0.0,   1.01, 0.0, 0.0
+  track_body = 'ring1', 'ring2'
+/
+&body
+  name = 'ring1', mesh = 'file', file = '%s'
+  velocity = 10.0, 0.0, 0.0
+  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05
+/
+&body
+  name = 'ring2', mesh = 'file', file = '%s', center = 2.01, 0.0, 0.0
+  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05
+/
+""" % (ring, ring)
+empty_msh = os.path.join(work, "empty.msh")
+with open(empty_msh, "w") as f:   # a valid Gmsh file with no 10-node triangle
+    f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 1 1 1\n0 1 0 1\n1\n0 0 0\n"
+            "$EndNodes\n$Elements\n1 1 1 1\n0 1 15 1\n1 1\n$EndElements\n")
+flat_msh = os.path.join(work, "flat.msh")
+with open(flat_msh, "w") as f:    # one element whose 10 nodes lie on a line: degenerate
+    f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 10 1 10\n2 1 0 10\n")
+    f.write("".join("%d\n" % i for i in range(1, 11)))
+    f.write("".join("%g 0 0\n" % (0.1 * i) for i in range(10)))
+    f.write("$EndNodes\n$Elements\n1 1 1 1\n2 1 21 1\n1 1 2 3 4 5 6 7 8 9 10\n$EndElements\n")
+
+cases = [  # (name, text transformation, substrings the message must hold)
+    ("missing deck file", None, ["no_such_deck.nml", "cannot open"]),
+    ("unknown group", lambda s: s.replace("&output", "&outptu"), ["&outptu", ":4:"]),
+    ("misspelt key", lambda s: s.replace("velocity", "velocty"), ["velocty", "velocity", ":11:"]),
+    ("wrong type", lambda s: s.replace("dt = 5.0e-5", "dt = 'fast'"), ["dt", "not a number", ":2:"]),
+    ("E not positive", lambda s: s.replace("young = 210e9", "young = -1.0", 1), ["young", "> 0"]),
+    ("rho not positive", lambda s: s.replace("density = 7700", "density = 0.0", 1), ["density", "> 0"]),
+    ("thickness not positive", lambda s: s.replace("thickness = 0.05", "thickness = 0.0", 1), ["thickness", "> 0"]),
+    ("dt not positive", lambda s: s.replace("dt = 5.0e-5", "dt = -1.0e-5"), ["dt", "> 0"]),
+    ("nu out of range", lambda s: s.replace("poisson = 0.3", "poisson = 0.5", 1), ["poisson", "(-1, 0.5)"]),
+    ("missing mesh file", lambda s: s.replace(ring, "/no/such/ring.msh", 1), ["/no/such/ring.msh", "does not exist"]),
+    ("empty mesh", lambda s: s.replace(ring, empty_msh, 1), ["empty.msh", "10-node triangles"]),
+    ("degenerate element", lambda s: s.replace(ring, flat_msh, 1), ["degenerate", "ring1"]),
+    ("restraint selects no node", lambda s: s + "&restraint\n body = 'ring2', box_min = 50.0, 50.0, 50.0, fix = 'y'\n/\n",
+     ["&restraint", "no node", "ring2"]),
+    ("unknown body in a restraint", lambda s: s + "&restraint\n body = 'ring9', fix = 'y'\n/\n", ["ring9", "not a body"]),
+    ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
+    ("bodies overlapping at the start", lambda s: s.replace("center = 2.01", "center = 1.99"),
+     ["overlap at the start", "ring1", "ring2"]),
+    ("missing required value", lambda s: s.replace("young = 210e9, ", "", 1), ["young", "missing"]),
+    ("unknown mesh kind", lambda s: s.replace("mesh = 'file'", "mesh = 'torus'", 1), ["torus", "mesh"]),
+]
+for name, change, needles in cases:
+    deck = os.path.join(work, "bad_%s.nml" % re.sub(r"\W+", "_", name))
+    if change is None:
+        deck = os.path.join(work, "no_such_deck.nml")
+    else:
+        with open(deck, "w") as f:
+            f.write(change(good))
+    p = run([casca, "run", deck, "--out", os.path.join(work, "bad_out")])
+    msg = p.stderr
+    ok = (p.returncode == 2 and all(n in msg for n in needles) and os.path.basename(deck) in msg
+          and "Backtrace" not in msg and "Error termination" not in msg)
+    ck.record("bad deck, %s: exit 2 and a message naming it" % name, ok,
+              "exit %d: %s" % (p.returncode, msg.strip().splitlines()[0] if msg.strip() else ""))
+ck.record("no output folder was made for bad decks", not os.path.exists(os.path.join(work, "bad_out")))
+
+# --- a short two-ring run: frames, collection, history in two formats
+deck = os.path.join(work, "good.nml")
+with open(deck, "w") as f:
+    f.write(good)
+out = os.path.join(work, "good_out")
+p = run([casca, "run", deck, "--out", out])
+ck.record("good deck runs (exit 0)", p.returncode == 0, p.stderr[-300:])
+ck.record("one progress line per output interval", len(re.findall(r"^step ", p.stdout, re.M)) == 6,
+          "%d lines" % len(re.findall(r"^step ", p.stdout, re.M)))
+pvd = ET.parse(os.path.join(out, "run.pvd")).getroot()
+frames = [(float(d.get("timestep")), d.get("file")) for d in pvd.iter("DataSet")]
+ck.record("run.pvd lists 7 frames (t = 0 and every 0.5 ms)", len(frames) == 7, str(len(frames)))
+ok = True
+for t, name in frames:
+    m = meshio.read(os.path.join(out, name))
+    ok &= (len(m.cells) == 1 and m.cells[0].type == "VTK_LAGRANGE_TRIANGLE"
+           and m.cells[0].data.shape == (80, 10) and m.points.shape == (480, 3)
+           and all(k in m.point_data for k in ("displacement", "velocity", "fibre", "thickness_param",
+                                               "contact_force", "signed_distance"))
+           and all(k in m.cell_data for k in ("body", "von_mises")))
+ck.record("meshio reads every frame: cell type 69, 80 cells x 10, 480 points, all fields", ok)
+
+# node order: the cubic map of the written frame 0 puts points on the ring's cylinder
+m = meshio.read(os.path.join(out, frames[0][1]))
+
+
+def shape(x1, x2):
+    L = [1 - x1 - x2, x1, x2]
+    v = [0.5 * l * (3 * l - 1) * (3 * l - 2) for l in L]
+    pairs = [(0, 1), (1, 0), (1, 2), (2, 1), (2, 0), (0, 2)]
+    e = [4.5 * L[a] * L[b] * (3 * L[a] - 1) for a, b in pairs]
+    return np.array(v + e + [27 * L[0] * L[1] * L[2]])
+
+
+rng = np.random.default_rng(1)
+worst = 0.0
+for cell in m.cells[0].data[:40]:            # ring 1, centred at the origin, axis z
+    xe = m.points[cell]
+    for _ in range(10):
+        a, b = rng.random(2)
+        if a + b > 1:
+            a, b = 1 - a, 1 - b
+        x = shape(a, b) @ xe
+        worst = max(worst, abs(np.hypot(x[0], x[1]) - 1.0))
+ck.le("frame geometry: interior points of the cubic cells on the cylinder r = 1 [m]", worst, 1e-4)
+
+h = history(out)
+with h5py.File(os.path.join(out, "history.h5"), "r") as f:
+    table = f["history"][()]
+    names = [c.decode() if isinstance(c, bytes) else str(c) for c in f["history"].attrs["columns"]]
+ck.record("history.h5 has the columns of history.dat", names == list(h.keys()))
+ck.le("history.h5 equals history.dat (max relative difference)",
+      max(np.max(np.abs(table[:, i] - h[n]) / (np.abs(h[n]) + 1e-300)) for i, n in enumerate(names)), 1e-14)
+needed = "t kinetic strain total px py pz Lx Ly Lz contacts newton".split()
+ck.record("history.dat header names the required columns", all(n in h for n in needed))
+for png in ("positions_x", "energy", "momentum", "contact"):
+    path = os.path.join(out, png + ".png")
+    ck.record("plot %s.png made after the run" % png,
+              os.path.exists(path) and open(path, "rb").read(8) == b"\x89PNG\r\n\x1a\n")
+shutil.rmtree(os.path.join(work, "replot"), ignore_errors=True)
+shutil.copytree(out, os.path.join(work, "replot"))
+for f in glob.glob(os.path.join(work, "replot", "*.png")):
+    os.remove(f)
+p = run([casca, "plot", os.path.join(work, "replot")])
+ck.record("casca plot DIR remakes the plots", p.returncode == 0 and
+          os.path.exists(os.path.join(work, "replot", "positions_x.png")))
+
+# --- restart: a run stopped at 1.5 ms and continued equals the uninterrupted run
+half = os.path.join(work, "half.nml")
+with open(half, "w") as f:
+    f.write(good.replace("t_end = 3.0e-3", "t_end = 1.5e-3"))
+out_r = os.path.join(work, "restart_out")
+p1 = run([casca, "run", half, "--out", out_r, "-q"])
+ckpt = os.path.join(work, "at_1.5ms.h5")
+shutil.copy(os.path.join(out_r, "checkpoint.h5"), ckpt)
+p2 = run([casca, "run", deck, "--out", out_r, "--restart", ckpt, "-q"])
+ck.record("restart run (exit 0)", p1.returncode == 0 and p2.returncode == 0, p2.stderr[-300:])
+hr = history(out_r)
+ck.record("restarted history has the same rows", len(hr["t"]) == len(h["t"]), "%d vs %d" % (len(hr["t"]), len(h["t"])))
+if len(hr["t"]) == len(h["t"]):
+    rel = max(np.max(np.abs(hr[k] - h[k])) / max(np.max(np.abs(h[k])), 1e-300)
+              for k in h if k.startswith("p") and "_" in k)
+    ck.le("restart equals the uninterrupted run (tracked nodes, relative)", rel, 1e-12)
+with h5py.File(os.path.join(out, "checkpoint.h5"), "r") as a, h5py.File(os.path.join(out_r, "checkpoint.h5"), "r") as b:
+    qa, qb = a["q"][()], b["q"][()]
+ck.le("restart: final positions equal (relative)", np.max(np.abs(qa - qb)) / np.max(np.abs(qa)), 1e-12)
+m = meshio.read(os.path.join(out_r, ET.parse(os.path.join(out_r, "run.pvd")).getroot().findall(".//DataSet")[-1].get("file")))
+ck.record("restarted run.pvd lists all 7 frames",
+          len(ET.parse(os.path.join(out_r, "run.pvd")).getroot().findall(".//DataSet")) == 7)
+
+# --- the solver cannot go on: exit 3, last good state and a restart file written
+stuck = os.path.join(work, "stuck.nml")
+with open(stuck, "w") as f:
+    f.write(good.replace("dt = 5.0e-5, t_end = 3.0e-3",
+                         "dt = 5.0e-5, t_end = 3.0e-3, newton_max_iter = 1, newton_tol = 1e-30, max_step_cuts = 1"))
+out_s = os.path.join(work, "stuck_out")
+p = run([casca, "run", stuck, "--out", out_s, "-q"])
+ck.record("solver failure: exit 3 with a message", p.returncode == 3 and "cannot go on" in p.stderr, p.stderr[-200:])
+ck.record("solver failure: checkpoint.h5 and a last frame written",
+          os.path.exists(os.path.join(out_s, "checkpoint.h5")) and os.path.exists(os.path.join(out_s, "run.pvd")))
+ck.finish()
