@@ -103,7 +103,7 @@ ck.record("no output folder was made for bad decks", not os.path.exists(os.path.
 # --- a short two-ring run: frames, collection, history in two formats
 deck = os.path.join(work, "good.nml")
 with open(deck, "w") as f:
-    f.write(good)
+    f.write(good.replace("interval = 5.0e-4", "interval = 5.0e-4, checkpoint_interval = 1.5e-3"))
 out = os.path.join(work, "good_out")
 p = run([casca, "run", deck, "--out", out])
 ck.record("good deck runs (exit 0)", p.returncode == 0, p.stderr[-300:])
@@ -167,10 +167,11 @@ p = run([casca, "plot", os.path.join(work, "replot")])
 ck.record("casca plot DIR remakes the plots", p.returncode == 0 and
           os.path.exists(os.path.join(work, "replot", "positions_x.png")))
 
-# --- restart: a run stopped at 1.5 ms and continued equals the uninterrupted run
+# --- restart: a run stopped at 1.5 ms and continued equals the uninterrupted run (both write
+# a checkpoint at 1.5 ms: the step after a checkpoint starts with a new factorisation)
 half = os.path.join(work, "half.nml")
 with open(half, "w") as f:
-    f.write(good.replace("t_end = 3.0e-3", "t_end = 1.5e-3"))
+    f.write(good.replace("t_end = 3.0e-3", "t_end = 1.5e-3").replace("interval = 5.0e-4", "interval = 5.0e-4, checkpoint_interval = 1.5e-3"))
 out_r = os.path.join(work, "restart_out")
 p1 = run([casca, "run", half, "--out", out_r, "-q"])
 ckpt = os.path.join(work, "at_1.5ms.h5")

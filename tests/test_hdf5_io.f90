@@ -154,6 +154,7 @@ contains
     type(error_t), allocatable :: err
     real(dp), allocatable :: q(:), qd(:), qdd(:), q2(:), qd2(:), qdd2(:)
     integer, allocatable :: ints(:), ints2(:)
+    real(dp), allocatable :: reals2(:)
     real(dp) :: t, t2
     integer :: step, step2, i, n
     logical :: exists
@@ -174,14 +175,14 @@ contains
     ints = [1, 0, -7, huge(1), -huge(1) - 1]
 
     ! A first checkpoint, then one overwriting it (the usual case during a run).
-    call write_checkpoint(ckpt_file, 1.0_dp, 1, q + 1, qd, qdd, [integer ::], err)
+    call write_checkpoint(ckpt_file, 1.0_dp, 1, q + 1, qd, qdd, [integer ::], [real(dp) ::], err)
     call ok_or_report('write first checkpoint', err)
-    call write_checkpoint(ckpt_file, t, step, q, qd, qdd, ints, err)
+    call write_checkpoint(ckpt_file, t, step, q, qd, qdd, ints, [0.5_dp, -1.25_dp, huge(1._dp)], err)
     call ok_or_report('write second checkpoint over it', err)
     inquire (file=ckpt_file//'.part', exist=exists)
     call check_true('no .part file left behind', .not. exists)
 
-    call read_checkpoint(ckpt_file, t2, step2, q2, qd2, qdd2, ints2, err)
+    call read_checkpoint(ckpt_file, t2, step2, q2, qd2, qdd2, ints2, reals2, err)
     call ok_or_report('read checkpoint', err)
     call check_true('checkpoint: t bitwise equal', same_bits(t2, t))
     call check_true('checkpoint: step equal', step2 == step)
@@ -191,24 +192,27 @@ contains
     call check_true('checkpoint: qdd bitwise equal', same_bits_1d(qdd2, qdd))
     call check_true('checkpoint: ints equal', allocated(ints2) .and. size(ints2) == size(ints))
     if (allocated(ints2)) call check_true('checkpoint: ints values', all(ints2 == ints))
+    call check_true('checkpoint: reals round trip exactly', allocated(reals2) .and. size(reals2) == 3)
+    if (allocated(reals2)) call check_true('checkpoint: reals values', &
+                                           all(reals2 == [0.5_dp, -1.25_dp, huge(1._dp)]))
 
     ! Empty ints and ndof = 0 round trip.
-    call write_checkpoint(ckpt_file, t, 0, q(1:0), qd(1:0), qdd(1:0), [integer ::], err)
+    call write_checkpoint(ckpt_file, t, 0, q(1:0), qd(1:0), qdd(1:0), [integer ::], [real(dp) ::], err)
     call ok_or_report('write checkpoint with ndof=0, no ints', err)
-    call read_checkpoint(ckpt_file, t2, step2, q2, qd2, qdd2, ints2, err)
+    call read_checkpoint(ckpt_file, t2, step2, q2, qd2, qdd2, ints2, reals2, err)
     call ok_or_report('read checkpoint with ndof=0, no ints', err)
     call check_true('empty checkpoint: arrays allocated', allocated(q2) .and. allocated(ints2))
     if (allocated(q2) .and. allocated(ints2)) &
       call check_true('empty checkpoint: sizes are 0', size(q2) == 0 .and. size(ints2) == 0)
 
-    call write_checkpoint(ckpt_file, t, step, q, qd(1:3), qdd, ints, err)
+    call write_checkpoint(ckpt_file, t, step, q, qd(1:3), qdd, ints, [real(dp) ::], err)
     call check_true('write_checkpoint with size(qd) /= size(q) refused', has_msg(err, ckpt_file))
   end subroutine test_checkpoint
 
   subroutine test_errors()
     type(error_t), allocatable :: err
     type(h5_table_t) :: tab
-    real(dp), allocatable :: q(:), qd(:), qdd(:)
+    real(dp), allocatable :: q(:), qd(:), qdd(:), reals2(:)
     integer, allocatable :: ints(:)
     real(dp) :: t
     integer :: step, u
@@ -217,15 +221,15 @@ contains
     write (u, '(a)') 'this is not an HDF5 file'
     close (u)
 
-    call read_checkpoint(missing_file, t, step, q, qd, qdd, ints, err)
+    call read_checkpoint(missing_file, t, step, q, qd, qdd, ints, reals2, err)
     call check_true('read_checkpoint of a missing file: error naming the file', &
                     has_msg(err, missing_file))
     call show(err)
-    call read_checkpoint(text_file, t, step, q, qd, qdd, ints, err)
+    call read_checkpoint(text_file, t, step, q, qd, qdd, ints, reals2, err)
     call check_true('read_checkpoint of a text file: error naming the file', &
                     has_msg(err, text_file))
     call show(err)
-    call read_checkpoint(table_file, t, step, q, qd, qdd, ints, err)
+    call read_checkpoint(table_file, t, step, q, qd, qdd, ints, reals2, err)
     call check_true('read_checkpoint of a table file: missing dataset /t, naming the file', &
                     has_msg(err, table_file) .and. has_msg(err, '/t'))
     call show(err)
@@ -237,7 +241,7 @@ contains
                     has_msg(err, ckpt_file) .and. has_msg(err, '/history'))
     call show(err)
     call write_checkpoint('no_such_dir/ckpt.h5', 0.0_dp, 0, [1.0_dp], [1.0_dp], [1.0_dp], &
-                          [integer ::], err)
+                          [integer ::], [real(dp) ::], err)
     call check_true('write_checkpoint into a missing folder: error naming the file', &
                     has_msg(err, 'no_such_dir/ckpt.h5'))
     call show(err)

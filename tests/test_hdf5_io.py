@@ -87,8 +87,8 @@ def check_checkpoint(path):
         return
     with f:
         keys = sorted(f.keys())
-        check(keys == sorted(["t", "step", "ndof", "q", "qd", "qdd", "ints"]),
-              f"{name}: datasets t, step, ndof, q, qd, qdd, ints (got {keys})")
+        check(keys == sorted(["t", "step", "ndof", "q", "qd", "qdd", "ints", "reals"]),
+              f"{name}: datasets t, step, ndof, q, qd, qdd, ints, reals (got {keys})")
         if "t" in f and "ndof" in f and "q" in f:
             check(same_bits(f["t"][()], 0.1 * 3.0) and f["ndof"][()] == 0
                   and f["q"].shape == (0,), f"{name}: t = 0.1*3, ndof = 0, q empty")

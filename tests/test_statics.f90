@@ -114,6 +114,7 @@ contains
     allocate (q(model%ndof))
     call reference_state(model, q)
     opts%tol = 1e-14_dp; opts%max_iter = 30
+    opts%reuse = .false.   ! full Newton: the rate test measures its order
     f = model%fext
     do lev = 1, nlev
       call newton_solve(model, asm, solver, q, f*(real(lev, dp)/nlev), opts, rep, err)

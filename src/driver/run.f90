@@ -93,6 +93,7 @@ contains
     type(error_t), allocatable :: err
     real(dp), allocatable :: fext(:), fgrav(:), q0(:)
     integer, allocatable :: tracked(:), ints(:)
+    real(dp), allocatable :: reals(:)
     character(len=128), allocatable :: labels(:)
     character(len=:), allocatable :: dir
     real(dp) :: interval, next_frame, next_ckpt, t0, t_start, dt
@@ -110,6 +111,7 @@ contains
     if (failed('setup')) return
     if (deck%run%ordering == 'metis') solver%ordering = 1
     opts%tol = deck%run%newton_tol; opts%max_iter = deck%run%newton_max_iter
+    opts%reuse = deck%run%reuse_factorisation
     allocate (fgrav(model%ndof))
     call gravity_load(model, fgrav)
     fext = model%fext + fgrav
@@ -128,7 +130,7 @@ contains
 
     level = 0; restart_step = -1
     if (restart /= '') then
-      call read_checkpoint(restart, st%t, st%step, st%q, st%qd, st%qdd, ints, err)
+      call read_checkpoint(restart, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err)
       if (allocated(err)) then
         if (is_root()) write (0, '(a,a)') 'error: ', err%message
         code = exit_input; return
@@ -146,6 +148,7 @@ contains
         do k = 1, contact%nact
           contact%act(k)%node = ints(1 + 2*k); contact%act(k)%pair = ints(2 + 2*k)
           contact%act(k)%elem = 0
+          contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
         end do
       end if
       restart_step = st%step
@@ -280,13 +283,16 @@ contains
 
     subroutine checkpoint()
       type(error_t), allocatable :: e
+      call solver%drop_factors()   ! on every rank: a restart from here starts with new factors
       if (.not. is_root()) return
       if (use_contact) then
         call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, &
                               [level, contact%nact, (contact%act(k)%node, contact%act(k)%pair, &
-                                                     k=1, contact%nact)], e)
+                                                     k=1, contact%nact)], &
+                              contact%act(1:contact%nact)%lambda, e)
       else
-        call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, [level], e)
+        call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, [level], &
+                              [real(dp) ::], e)
       end if
       if (allocated(e)) then
         write (0, '(a,a)') 'error (checkpoint): ', e%message

@@ -31,6 +31,7 @@ module casca_deck
     integer :: newton_max_iter = 20
     integer :: load_steps = 10
     integer :: max_step_cuts = 4
+    logical :: reuse_factorisation = .true.     !< modified Newton while it contracts fast
     real(dp) :: gravity(3) = 0
     character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
   end type run_cfg_t
@@ -320,14 +321,15 @@ contains
     character(len=16) :: analysis, ordering
     real(dp) :: dt, t_end, beta, gamma, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
+    logical :: reuse_factorisation
     character(len=256) :: msg
     namelist /run/ title, analysis, dt, t_end, beta, gamma, newton_tol, newton_max_iter, &
-      load_steps, max_step_cuts, gravity, ordering
+      load_steps, max_step_cuts, gravity, ordering, reuse_factorisation
     associate (c => deck%run)
       title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = c%beta
       gamma = c%gamma; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
-      ordering = c%ordering
+      ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
       if (line == 0) return
       rewind (u)
       read (u, nml=run, iostat=ios, iomsg=msg)
@@ -337,7 +339,7 @@ contains
       c%title = title; c%analysis = lower(analysis); c%dt = dt; c%t_end = t_end; c%beta = beta
       c%gamma = gamma; c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
-      c%ordering = lower(ordering)
+      c%ordering = lower(ordering); c%reuse_factorisation = reuse_factorisation
     end associate
   end subroutine read_run
 

@@ -15,7 +15,7 @@
 !> file is flushed to disk only by h5_table_flush (and close).
 !>
 !> Checkpoint layout: scalar datasets "/t" (float64), "/step" and "/ndof" (int32), 1-D
-!> datasets "/q", "/qd", "/qdd" (float64, ndof) and "/ints" (int32, possibly empty). It is
+!> datasets "/q", "/qd", "/qdd" (float64, ndof), "/ints" (int32) and "/reals" (float64), both possibly empty. It is
 !> written to <path>.part and renamed onto <path> only when complete and closed, so a crash
 !> while writing never replaces a good checkpoint (rename(2) is atomic on one file system).
 module casca_hdf5_io
@@ -323,13 +323,15 @@ contains
   ! ---------------------------------------------------------------------------------------
 
   !> Write a restart checkpoint to path (via path.part, renamed when complete).
-  !> q, qd, qdd must have the same size ndof; ints may have any size, including 0.
-  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, err)
+  !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
+  !> have any size, including 0.
+  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
     real(dp), intent(in) :: q(:), qd(:), qdd(:)
     integer, intent(in) :: ints(:)
+    real(dp), intent(in) :: reals(:)
     type(error_t), allocatable, intent(out) :: err
 
     character(len=*), parameter :: who = 'write_checkpoint'
@@ -359,6 +361,7 @@ contains
     if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'qd', qd, err)
     if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'qdd', qdd, err)
     if (.not. allocated(err)) call put_int_1d(who, tmp, fid, 'ints', ints, err)
+    if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'reals', reals, err)
     call h5fclose_f(fid, h)
     if (allocated(err)) then
       call delete_file(tmp)
@@ -377,12 +380,13 @@ contains
   end subroutine write_checkpoint
 
   !> Read a checkpoint written by write_checkpoint.
-  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, err)
+  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
     real(dp), allocatable, intent(out) :: q(:), qd(:), qdd(:)
     integer, allocatable, intent(out) :: ints(:)
+    real(dp), allocatable, intent(out) :: reals(:)
     type(error_t), allocatable, intent(out) :: err
 
     character(len=*), parameter :: who = 'read_checkpoint'
@@ -400,6 +404,7 @@ contains
     if (.not. allocated(err)) call get_real_1d(who, path, fid, 'qd', qd, err)
     if (.not. allocated(err)) call get_real_1d(who, path, fid, 'qdd', qdd, err)
     if (.not. allocated(err)) call get_int_1d(who, path, fid, 'ints', ints, err)
+    if (.not. allocated(err)) call get_real_1d(who, path, fid, 'reals', reals, err)
     call h5fclose_f(fid, h)
     if (allocated(err)) return
     if (size(q) /= ndof .or. size(qd) /= ndof .or. size(qdd) /= ndof) then

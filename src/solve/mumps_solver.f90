@@ -23,6 +23,7 @@ module casca_mumps_solver
     type(dmumps_struc), private :: id
     logical :: started = .false.
     logical :: analysed = .false.
+    logical :: factored = .false.   !< holds factors of the analysed pattern
     !> ICNTL(7): 7 = MUMPS chooses (PORD here), 1 = METIS nested dissection given by casca;
     !> equal within 3% on the 720-element sphere (docs/performance.md), so MUMPS chooses
     integer :: ordering = 7
@@ -32,6 +33,7 @@ module casca_mumps_solver
     procedure :: factorise => solver_factorise
     procedure :: solve => solver_solve
     procedure :: negative_pivots => solver_negative_pivots
+    procedure :: drop_factors => solver_drop_factors
     procedure :: finish => solver_finish
   end type sparse_solver_t
 
@@ -79,6 +81,7 @@ contains
     call dmumps(self%id)
     call check(self, 'analysis', err)
     self%analysed = .not. allocated(err)
+    self%factored = .false.
   end subroutine solver_analyse
 
   !> Numerical factorisation of this rank's values (same order as the analysed pattern).
@@ -96,6 +99,7 @@ contains
       self%id%icntl(14) = 2*self%id%icntl(14)
     end do
     call check(self, 'factorisation', err)
+    self%factored = .not. allocated(err)
   end subroutine solver_factorise
 
   !> x = K^-1 b; b needed on rank 0 only, x returned on every rank.
@@ -125,6 +129,13 @@ contains
     solver_negative_pivots = self%id%infog(12)
   end function solver_negative_pivots
 
+  !> The next solve refactorises: used after a checkpoint so that a run restarted from it
+  !> takes exactly the path of the run that wrote it.
+  subroutine solver_drop_factors(self)
+    class(sparse_solver_t), intent(inout) :: self
+    self%factored = .false.
+  end subroutine solver_drop_factors
+
   subroutine solver_finish(self)
     class(sparse_solver_t), intent(inout) :: self
     if (.not. self%started) return
@@ -133,7 +144,7 @@ contains
     if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
     self%id%job = -2
     call dmumps(self%id)
-    self%started = .false.; self%analysed = .false.
+    self%started = .false.; self%analysed = .false.; self%factored = .false.
   end subroutine solver_finish
 
   subroutine check(self, what, err)

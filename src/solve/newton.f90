@@ -1,9 +1,12 @@
 !> Newton-Raphson on r(q) = f_int(q) [+ inertia] - f_ext = 0 with the analytic tangent,
 !> factorised by MUMPS. With contact, each iteration solves the saddle-point system
-!>     [ K  C^T ] [ dq     ]   [ -r ]
-!>     [ C  0   ] [ lambda ] = [ -g ]
-!> for the increment and the (total) multipliers. Convergence: the largest increment,
-!> relative to the size of the scene, below tol, with a settled active set.
+!>     [ K  C^T ] [ dq      ]   [ -r - C^T lambda ]
+!>     [ C  0   ] [ dlambda ] = [ -g              ]
+!> Convergence: the largest increment, relative to the size of the scene, below tol, with a
+!> settled active set. With reuse, a factorisation is kept across iterations and steps while
+!> each iteration shrinks the increment at least fourfold (modified Newton: only the force is
+!> assembled then); the incremental form above makes a stale matrix change the path, never
+!> the converged answer.
 module casca_newton
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -25,6 +28,7 @@ module casca_newton
   type :: newton_opts_t
     real(dp) :: tol = 1e-10_dp   !< max |dq| / scene size
     integer :: max_iter = 25
+    logical :: reuse = .true.    !< keep factorisations while they converge fast enough
   end type newton_opts_t
 
   type :: newton_report_t
@@ -34,6 +38,7 @@ module casca_newton
     real(dp) :: energy = 0           !< strain energy at the last assembled iterate
     integer :: neg_pivots = 0        !< of the last factorisation (inertia)
     integer :: analyses = 0          !< symbolic analyses done in this solve
+    integer :: factorisations = 0    !< numerical factorisations done in this solve
   end type newton_report_t
 
 contains
@@ -51,17 +56,13 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:)
     integer, allocatable :: cirn(:), cjcn(:)
-    integer :: it, i, nc, added, released
+    integer :: it, i, nc, added, released, k
     real(dp) :: nrm
-    logical :: settled
+    logical :: settled, fresh
 
     allocate (r(model%ndof))
     if (present(contact)) contact%changes = 0
     do it = 1, min(opts%max_iter, max_hist)
-      call timer_start(t_assembly)
-      call assemble(model, asm, q, .true., r, rep%energy, cm, qs)
-      r = r - fext
-      call timer_stop(t_assembly)
       nc = 0
       call timer_start(t_contact)
       if (present(contact)) then
@@ -77,19 +78,36 @@ contains
       call analyse_if_needed()
       call timer_stop(t_analysis)
       if (allocated(err)) return
-      call timer_start(t_factor)
-      if (is_root()) then
-        call solver%factorise([asm%a, cval], err)
-      else
-        call solver%factorise(asm%a, err)
+
+      ! a new matrix unless the kept one still contracts the increment fourfold
+      ! (decided from replicated figures, so alike on every rank)
+      fresh = .not. (opts%reuse .and. solver%factored)
+      if (.not. fresh .and. it >= 3) fresh = rep%incr(it - 1) > 0.25_dp*rep%incr(it - 2)
+      if (it > 8) fresh = .true.
+      call timer_start(t_assembly)
+      call assemble(model, asm, q, fresh, r, rep%energy, cm, qs)
+      r = r - fext
+      call timer_stop(t_assembly)
+      if (fresh) then
+        call timer_start(t_factor)
+        if (is_root()) then
+          call solver%factorise([asm%a, cval], err)
+        else
+          call solver%factorise(asm%a, err)
+        end if
+        call timer_stop(t_factor)
+        if (allocated(err)) return
+        rep%factorisations = rep%factorisations + 1
       end if
-      call timer_stop(t_factor)
-      if (allocated(err)) return
-      rep%neg_pivots = solver%negative_pivots()
+
       allocate (b(asm%neq + nc), x(asm%neq + nc))
       if (is_root()) then
         do i = 1, model%ndof
           if (asm%eq(i) > 0) b(asm%eq(i)) = -r(i)
+        end do
+        do k = 1, size(cirn)   ! the multipliers' force C^T lambda, with the current rows
+          if (cirn(k) /= cjcn(k)) &
+            b(cjcn(k)) = b(cjcn(k)) - cval(k)*contact%act(cirn(k) - asm%neq)%lambda
         end do
         b(asm%neq + 1:) = -gap
       end if
@@ -100,7 +118,7 @@ contains
       do i = 1, model%ndof
         if (asm%eq(i) > 0) q(i) = q(i) + x(asm%eq(i))
       end do
-      if (nc > 0) contact%act(1:nc)%lambda = x(asm%neq + 1:)
+      if (nc > 0) contact%act(1:nc)%lambda = contact%act(1:nc)%lambda + x(asm%neq + 1:)
       nrm = maxval(abs(x(1:asm%neq)))/model%length
       deallocate (b, x, cirn, cjcn, cval, gap)
       rep%iters = it
@@ -123,6 +141,7 @@ contains
       end if
       if (settled) then
         rep%converged = .true.
+        rep%neg_pivots = solver%negative_pivots()   ! of the factors in use
         return
       end if
     end do

@@ -21,7 +21,9 @@ program bench_solver
   type(sparse_solver_t) :: solver
   type(error_t), allocatable :: err
   real(dp), allocatable :: q(:), r(:), b(:), x(:), qs(:)
-  real(dp) :: qe(7, 10), fe(70), ke(70, 70), u, t0, t_el, t_as, t_fa, t_so, t_an, flops
+  real(dp) :: qe(7, 10), fe(70), ke(70, 70), u, t0, t_el, t_as, t_fa, t_so, t_an, flops, t_f
+  real(dp) :: gemm_rate
+  real(dp), allocatable :: ga(:, :), gb(:, :), gc(:, :)
   integer :: ndiv, i, e, nrep, nel
   integer, allocatable :: perm(:)
   character(len=16) :: arg
@@ -52,6 +54,21 @@ program bench_solver
     end do
   end do
   t_el = (wall_time() - t0)/(nrep*nel)
+  t0 = wall_time()
+  do i = 1, nrep
+    do e = 1, nel
+      call gather(e, qe)
+      call shell_energy_force(model%rule, 0.05_dp, model%body(1)%lam, model%body(1)%mu, &
+                              model%binv(:, :, :, e), model%wdet(:, e), qe, .false., u, fe, ke)
+    end do
+  end do
+  t_f = (wall_time() - t0)/(nrep*nel)
+  ! the machine's DGEMM rate (BLAS in use), the yardstick for the kernel's rate
+  allocate (ga(1000, 1000), gb(1000, 1000), gc(1000, 1000))
+  call random_number(ga); call random_number(gb)
+  t0 = wall_time()
+  call dgemm('N', 'N', 1000, 1000, 1000, 1._dp, ga, 1000, gb, 1000, 0._dp, gc, 1000)
+  gemm_rate = 2e9_dp/(wall_time() - t0)*1e-9
   ! flops per element, counted from the kernel's loops (multiply-adds counted as 2)
   flops = model%rule%np*(20*9*20*9._dp + 10*(20*3*3*2 + 27*10) + 55*60._dp + 3000)
 
@@ -82,8 +99,10 @@ program bench_solver
     print '(a,i0,a,i0,a,i0,a,i0)', 'sphere n_div=', ndiv, ': elements ', model%nelem, &
       ', nodes ', model%nnode, ', unknowns ', asm%neq
     print '(a,i0)', 'ranks: ', n_ranks
-    print '(a,f8.4,a,f6.2,a)', 'element force+Hessian: ', 1e3*t_el, ' ms/element  (', &
-      flops/t_el*1e-9, ' GFlop/s)'
+    print '(a,f8.4,a,f6.2,a,f5.1,a)', 'element force+Hessian: ', 1e3*t_el, ' ms/element  (', &
+      flops/t_el*1e-9, ' GFlop/s, ', 100*flops/t_el*1e-9/gemm_rate, '% of DGEMM)'
+    print '(a,f8.4,a)', 'element force only:    ', 1e3*t_f, ' ms/element'
+    print '(a,f8.2,a)', 'DGEMM 1000x1000:       ', gemm_rate, ' GFlop/s (this machine, this BLAS)'
     print '(a,f8.4,a)', 'analysis (once):       ', t_an, ' s'
     print '(a,f8.4,a)', 'assembly / iteration:  ', t_as/nrep, ' s'
     print '(a,f8.4,a)', 'factorisation / iter.: ', t_fa/nrep, ' s'
