@@ -37,6 +37,14 @@ module casca_contact
     integer :: changes = 0                      !< active-set changes in this step
     integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
     real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
+    logical :: schur = .true.                   !< solve through the Schur complement of K
+    ! Schur cache (rank 0): Z = K^-1 C^T and S = C Z for the rows (z_irn, z_jcn, z_val) and
+    ! the factorisation z_factor of K they were computed with
+    real(dp), allocatable :: z(:, :), s(:, :)
+    integer, allocatable :: z_irn(:), z_jcn(:), z_ipiv(:)
+    real(dp), allocatable :: z_val(:)
+    integer :: z_factor = -1
+    integer :: z_positive = 0                   !< positive eigenvalues of S
   end type contact_t
 
 contains

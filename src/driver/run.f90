@@ -233,7 +233,10 @@ contains
       integer, allocatable :: pairs(:, :)
       pairs = contact_pairs(deck, model)
       use_contact = size(pairs, 2) > 0
-      if (use_contact) call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
+      if (use_contact) then
+        call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
+        contact%schur = deck%contact%solver == 'schur'
+      end if
     end subroutine setup_contact
 
     subroutine history_row(newton)

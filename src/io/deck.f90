@@ -80,6 +80,7 @@ module casca_deck
     integer :: npairs = 0                       !< 0: every pair of bodies
     character(len=64) :: pairs(2, max_pairs) = ''
     real(dp) :: tolerance = 1e-7_dp             !< penetration accepted, relative to scene size
+    character(len=16) :: solver = 'schur'       !< 'schur' or 'saddle' (docs/method.md)
     integer :: line = 0
   end type contact_cfg_t
 
@@ -383,11 +384,12 @@ contains
     logical :: enabled
     character(len=64) :: pairs(2, max_pairs)
     real(dp) :: tolerance
+    character(len=16) :: solver
     character(len=256) :: msg
     integer :: ios, k
-    namelist /contact/ enabled, pairs, tolerance
+    namelist /contact/ enabled, pairs, tolerance, solver
     associate (c => deck%contact)
-      enabled = c%enabled; pairs = ''; tolerance = c%tolerance
+      enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -395,7 +397,7 @@ contains
       if (ios /= 0) then
         call add_problem(deck, line, '&contact: '//trim(msg)); return
       end if
-      c%enabled = enabled; c%tolerance = tolerance; c%pairs = pairs
+      c%enabled = enabled; c%tolerance = tolerance; c%pairs = pairs; c%solver = lower(solver)
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit

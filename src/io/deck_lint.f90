@@ -46,7 +46,7 @@ contains
       end select
     case ('contact')
       select case (key)
-      case ('pairs'); t = 's'
+      case ('pairs', 'solver'); t = 's'
       case ('tolerance'); t = 'r'
       case ('enabled'); t = 'l'
       end select
@@ -219,7 +219,7 @@ contains
       'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
       'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
       'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &
-      'force', 'pairs', 'tolerance', 'enabled']
+      'force', 'pairs', 'tolerance', 'enabled', 'solver']
     integer :: i, d, best
     s = ''
     best = 3

@@ -130,6 +130,8 @@ contains
       end do
     end do
     call positive(deck%contact%line, '&contact: tolerance', deck%contact%tolerance)
+    if (deck%contact%solver /= 'schur' .and. deck%contact%solver /= 'saddle') &
+      call add_problem(deck, deck%contact%line, '&contact: solver must be ''schur'' or ''saddle''')
   contains
     subroutine positive(line, field, v)
       integer, intent(in) :: line

@@ -24,6 +24,7 @@ module casca_mumps_solver
     logical :: started = .false.
     logical :: analysed = .false.
     logical :: factored = .false.   !< holds factors of the analysed pattern
+    integer :: factorisations = 0   !< counter: tells whether factors changed
     !> ICNTL(7): 7 = MUMPS chooses (PORD here), 1 = METIS nested dissection given by casca;
     !> equal within 3% on the 720-element sphere (docs/performance.md), so MUMPS chooses
     integer :: ordering = 7
@@ -32,6 +33,7 @@ module casca_mumps_solver
     procedure :: analyse => solver_analyse
     procedure :: factorise => solver_factorise
     procedure :: solve => solver_solve
+    procedure :: solve_many => solver_solve_many
     procedure :: negative_pivots => solver_negative_pivots
     procedure :: drop_factors => solver_drop_factors
     procedure :: finish => solver_finish
@@ -100,6 +102,7 @@ contains
     end do
     call check(self, 'factorisation', err)
     self%factored = .not. allocated(err)
+    self%factorisations = self%factorisations + 1
   end subroutine solver_factorise
 
   !> x = K^-1 b; b needed on rank 0 only, x returned on every rank.
@@ -122,6 +125,29 @@ contains
     if (is_root()) x = self%id%rhs
     call bcast_real(x)
   end subroutine solver_solve
+
+  !> X = K^-1 B for several right-hand sides at once (B, X: (n, m) on rank 0; X is
+  !> returned on rank 0 only).
+  subroutine solver_solve_many(self, b, x, err)
+    class(sparse_solver_t), intent(inout) :: self
+    real(dp), intent(in) :: b(:, :)
+    real(dp), intent(out) :: x(:, :)
+    type(error_t), allocatable, intent(out) :: err
+    integer :: n, m
+    n = size(b, 1); m = size(b, 2)
+    if (is_root()) then
+      if (associated(self%id%rhs)) deallocate (self%id%rhs)
+      allocate (self%id%rhs(n*m))
+      self%id%rhs = reshape(b, [n*m])
+    end if
+    self%id%nrhs = m; self%id%lrhs = n
+    self%id%job = 3
+    call dmumps(self%id)
+    self%id%nrhs = 1
+    call check(self, 'solution', err)
+    if (allocated(err)) return
+    if (is_root()) x = reshape(self%id%rhs, [n, m])
+  end subroutine solver_solve_many
 
   !> Negative pivots of the last factorisation (the inertia of a saddle-point matrix).
   integer function solver_negative_pivots(self)

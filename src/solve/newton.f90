@@ -3,7 +3,10 @@
 !>     [ K  C^T ] [ dq      ]   [ -r - C^T lambda ]
 !>     [ C  0   ] [ dlambda ] = [ -g              ]
 !> Convergence: the largest increment, relative to the size of the scene, below tol, with a
-!> settled active set. With reuse, a factorisation is kept across iterations and steps while
+!> settled active set. By default (contact solver 'schur') the constraints are not put in the
+!> factorised matrix: K alone is factorised, with a pattern that never changes, and the system
+!> is solved through the Schur complement C K^-1 C^T; 'saddle' factorises the whole
+!> saddle-point matrix (re-analysed whenever the constraint pattern changes). With reuse, a factorisation is kept across iterations and steps while
 !> each iteration shrinks the increment at least fourfold (modified Newton: only the force is
 !> assembled then); the incremental form above makes a stale matrix change the path, never
 !> the converged answer.
@@ -14,7 +17,7 @@ module casca_newton
   use casca_assembly, only: assembly_t, assemble
   use casca_mumps_solver, only: sparse_solver_t
   use casca_contact, only: contact_t, contact_update, contact_release, contact_rows
-  use casca_mpi, only: is_root
+  use casca_mpi, only: is_root, bcast_real, bcast_int
   use casca_metis, only: nested_dissection
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve
@@ -54,13 +57,16 @@ contains
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: cm, qs(:)
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:)
-    integer, allocatable :: cirn(:), cjcn(:)
-    integer :: it, i, nc, added, released, k
+    real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:), cval_f(:)
+    integer, allocatable :: cirn(:), cjcn(:), cirn_f(:), cjcn_f(:)
+    integer :: it, i, nc, added, released, k, schur_positive
     real(dp) :: nrm
-    logical :: settled, fresh
+    logical :: settled, fresh, schur, renew_z
 
-    allocate (r(model%ndof))
+    allocate (r(model%ndof), cirn_f(0), cjcn_f(0), cval_f(0))
+    schur = .false.
+    if (present(contact)) schur = contact%schur
+    schur_positive = 0
     if (present(contact)) contact%changes = 0
     do it = 1, min(opts%max_iter, max_hist)
       nc = 0
@@ -74,15 +80,30 @@ contains
         allocate (cirn(0), cjcn(0), cval(0), gap(0))
       end if
       call timer_stop(t_contact)
+      if (schur) then   ! the constraints stay out of the factorised matrix
+        deallocate (cirn_f, cjcn_f, cval_f); allocate (cirn_f(0), cjcn_f(0), cval_f(0))
+      else
+        cirn_f = cirn; cjcn_f = cjcn; cval_f = cval
+      end if
       call timer_start(t_analysis)
       call analyse_if_needed()
       call timer_stop(t_analysis)
       if (allocated(err)) return
 
-      ! a new matrix unless the kept one still contracts the increment fourfold
-      ! (decided from replicated figures, so alike on every rank)
+      ! a new matrix unless the kept one still contracts the increment fourfold (decided from
+      ! replicated figures, so alike on every rank). With constraints, slow contraction comes
+      ! first from the constraint rows (their normal is held): the Schur cache is renewed
+      ! first, K only if contraction stays poor.
       fresh = .not. (opts%reuse .and. solver%factored)
-      if (.not. fresh .and. it >= 3) fresh = rep%incr(it - 1) > 0.25_dp*rep%incr(it - 2)
+      renew_z = .false.
+      if (it >= 3) renew_z = rep%incr(it - 1) > 0.25_dp*rep%incr(it - 2)
+      if (.not. fresh) then
+        if (schur .and. nc > 0) then
+          if (it >= 4) fresh = rep%incr(it - 1) > 0.5_dp*rep%incr(it - 2)
+        else
+          fresh = renew_z
+        end if
+      end if
       if (it > 8) fresh = .true.
       call timer_start(t_assembly)
       call assemble(model, asm, q, fresh, r, rep%energy, cm, qs)
@@ -91,7 +112,7 @@ contains
       if (fresh) then
         call timer_start(t_factor)
         if (is_root()) then
-          call solver%factorise([asm%a, cval], err)
+          call solver%factorise([asm%a, cval_f], err)
         else
           call solver%factorise(asm%a, err)
         end if
@@ -112,7 +133,11 @@ contains
         b(asm%neq + 1:) = -gap
       end if
       call timer_start(t_solve)
-      call solver%solve(b, x, err)
+      if (schur .and. nc > 0) then
+        call schur_solve()
+      else
+        call solver%solve(b, x, err)
+      end if
       call timer_stop(t_solve)
       if (allocated(err)) return
       do i = 1, model%ndof
@@ -142,40 +167,124 @@ contains
       if (settled) then
         rep%converged = .true.
         rep%neg_pivots = solver%negative_pivots()   ! of the factors in use
+        if (schur .and. nc > 0) rep%neg_pivots = rep%neg_pivots + schur_positive
         return
       end if
     end do
   contains
+    !> The saddle-point system through the Schur complement of K: Z = K^-1 C^T, S = C Z,
+    !> y = K^-1 b, S dlambda = C y + g, dq = y - Z dlambda. Z and S are kept (with the rows
+    !> they were made from) while the rows' pattern and K's factors stay and contraction is
+    !> good, so most iterations cost one solve. The inertia of the saddle-point matrix is that
+    !> of K plus the positive eigenvalues of S.
+    subroutine schur_solve()
+      real(dp), allocatable :: bb(:, :), yy(:, :), sc(:, :), rhs(:), eig(:), work(:), y(:)
+      integer :: e, kk, info, lwork
+      logical :: valid
+      valid = .false.
+      if (allocated(contact%z_irn)) then
+        valid = .not. renew_z .and. contact%z_factor == solver%factorisations .and. &
+                size(contact%z_irn) == size(cirn)
+        if (valid) valid = all(contact%z_irn == cirn) .and. all(contact%z_jcn == cjcn)
+      end if
+      if (.not. valid) then   ! Z and S from the current rows: nc + 1 right-hand sides
+        allocate (bb(asm%neq, nc + 1), yy(asm%neq, nc + 1))
+        bb = 0
+        bb(:, 1) = b(1:asm%neq)
+        do e = 1, size(cirn)
+          if (cirn(e) /= cjcn(e)) bb(cjcn(e), 1 + cirn(e) - asm%neq) = cval(e)
+        end do
+        call solver%solve_many(bb, yy, err)
+        if (allocated(err)) return
+        contact%z_irn = cirn; contact%z_jcn = cjcn; contact%z_val = cval
+        contact%z_factor = solver%factorisations
+        if (is_root()) then
+          contact%z = yy(:, 2:)
+          y = yy(:, 1)
+          if (allocated(contact%s)) deallocate (contact%s)
+          allocate (contact%s(nc, nc))
+          contact%s = 0
+          do e = 1, size(cirn)
+            if (cirn(e) == cjcn(e)) cycle
+            kk = cirn(e) - asm%neq
+            contact%s(kk, :) = contact%s(kk, :) + cval(e)*contact%z(cjcn(e), :)
+          end do
+          contact%s = 0.5_dp*(contact%s + transpose(contact%s))
+          sc = contact%s
+          lwork = max(1, 3*nc)
+          allocate (eig(nc), work(lwork))
+          call dsyev('N', 'U', nc, sc, nc, eig, work, lwork, info)
+          contact%z_positive = count(eig > 0)
+          if (allocated(contact%z_ipiv)) deallocate (contact%z_ipiv)
+          allocate (contact%z_ipiv(nc))
+          call dgetrf(nc, nc, contact%s, nc, contact%z_ipiv, info)
+          if (info /= 0) contact%z_ipiv = -1   ! dependent constraints: no correction
+        end if
+      else                    ! the kept Z and S: one right-hand side
+        allocate (y(asm%neq))
+        call solver%solve(b(1:asm%neq), y, err)
+        if (allocated(err)) return
+      end if
+      if (is_root()) then
+        rhs = gap   ! C_kept y + g: the matrix is [K, C_kept^T; C_kept, 0] throughout
+        do e = 1, size(contact%z_irn)
+          if (contact%z_irn(e) == contact%z_jcn(e)) cycle
+          kk = contact%z_irn(e) - asm%neq
+          rhs(kk) = rhs(kk) + contact%z_val(e)*y(contact%z_jcn(e))
+        end do
+        if (contact%z_ipiv(1) > 0) then
+          call dgetrs('N', nc, 1, contact%s, nc, contact%z_ipiv, rhs, nc, info)
+        else
+          rhs = 0
+        end if
+        x(1:asm%neq) = y - matmul(contact%z, rhs)
+        x(asm%neq + 1:) = rhs
+      end if
+      call bcast_real(x)
+      schur_positive = contact%z_positive
+      call bcast_int_scalar(schur_positive)
+    end subroutine schur_solve
+
+    subroutine bcast_int_scalar(i)
+      integer, intent(inout) :: i
+      integer :: v(1)
+      v(1) = i
+      call bcast_int(v)
+      i = v(1)
+    end subroutine bcast_int_scalar
+
     !> symbolic analysis at the first solve and whenever the constraint rows change
     subroutine analyse_if_needed()
       integer, allocatable :: perm(:)
+      integer :: nf
       if (solver%analysed) then
         if (.not. present(contact)) return
         if (same_pattern()) return
       end if
       allocate (perm(0))
+      nf = count(cirn_f == cjcn_f)   ! multipliers inside the factorised matrix
       if (solver%ordering == 1 .and. is_root()) then
-        deallocate (perm); allocate (perm(asm%neq + nc))
+        deallocate (perm); allocate (perm(asm%neq + nf))
         call nested_dissection(model%conn, model%nnode, asm%eq, asm%neq, perm, err)
         if (allocated(err)) return
-        perm(asm%neq + 1:) = [(asm%neq + i, i=1, nc)]   ! multipliers last
+        perm(asm%neq + 1:) = [(asm%neq + i, i=1, nf)]   ! multipliers last
       end if
       if (is_root()) then
-        call solver%analyse(asm%neq + nc, [asm%irn, cirn], [asm%jcn, cjcn], perm, err)
+        call solver%analyse(asm%neq + nf, [asm%irn, cirn_f], [asm%jcn, cjcn_f], perm, err)
       else
-        call solver%analyse(asm%neq + nc, asm%irn, asm%jcn, perm, err)
+        call solver%analyse(asm%neq + nf, asm%irn, asm%jcn, perm, err)
       end if
       rep%analyses = rep%analyses + 1
       if (present(contact)) then
-        contact%last_irn = cirn; contact%last_jcn = cjcn
+        contact%last_irn = cirn_f; contact%last_jcn = cjcn_f
       end if
     end subroutine analyse_if_needed
 
     logical function same_pattern()
       same_pattern = .false.
       if (.not. allocated(contact%last_irn)) return
-      if (size(contact%last_irn) /= size(cirn)) return
-      same_pattern = all(contact%last_irn == cirn) .and. all(contact%last_jcn == cjcn)
+      if (size(contact%last_irn) /= size(cirn_f)) return
+      same_pattern = all(contact%last_irn == cirn_f) .and. all(contact%last_jcn == cjcn_f)
     end function same_pattern
   end subroutine newton_solve
 end module casca_newton

@@ -1,0 +1,126 @@
+"""Numerical stability on hard cases (issue: speed against error, stability).
+
+usage: test_hard_cases.py CASCA MESH_DIR WORK_DIR
+Each case states its bound; all use the ring mesh of the thesis (40 cubic triangles)."""
+import os
+import sys
+
+import numpy as np
+
+from casca_testlib import Checks, history, run
+
+casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
+os.makedirs(work, exist_ok=True)
+ck = Checks()
+ring = os.path.join(meshdir, "ring_20x1.msh")
+STEEL = "young = 210e9, poisson = 0.3, density = 7700"
+
+
+def rings(name, v=10.0, dt=5e-5, t_end=0.03, center="2.01, 0.0, 0.0", thickness=0.05,
+          beta=1.0, gamma=1.5, extra_run=""):
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(f"""&run dt = {dt}, t_end = {t_end}, beta = {beta}, gamma = {gamma} {extra_run} /
+&output interval = {max(dt, t_end / 20)}, vtu = .false., plots = .false.,
+  track = 1.0, 0.0, 0.0, track_body = 'ring1' /
+&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = {v}, 0.0, 0.0,
+  {STEEL}, thickness = {thickness} /
+&body name = 'ring2', mesh = 'file', file = '{ring}', center = {center},
+  {STEEL}, thickness = {thickness} /
+""")
+    out = os.path.join(work, name)
+    p = run([casca, "run", deck, "--out", out, "-q"])
+    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
+    return history(out) if p.returncode == 0 else None
+
+
+def momentum_error(h):
+    p = np.stack([h["px"], h["py"], h["pz"]]).T
+    return np.max(np.linalg.norm(p - p[0], axis=1)) / np.linalg.norm(p[0])
+
+
+def common(name, h, touch=True):
+    if h is None:
+        return
+    ck.le("%s: linear momentum kept (max |p - p0| / |p0|)" % name, momentum_error(h), 1e-8)
+    ck.le("%s: deepest penetration of a converged step [m]" % name, h["penetration"].max(), 1e-6)
+    ck.record("%s: no blow-up (all figures finite)" % name,
+              all(np.all(np.isfinite(v)) for v in h.values()))
+    if touch:
+        ck.record("%s: the bodies touch" % name, h["contacts"].max() > 0)
+
+
+# ten times the impact speed
+h = rings("fast_100ms", v=100.0, t_end=0.01)
+common("fast_100ms", h)
+if h is not None:
+    ck.le("fast_100ms: total energy never grows (max E / E0)", h["total"].max() / h["total"][0], 1.0 + 1e-9)
+
+# grazing oblique impact: ring 2's lowest point 0.1 m below ring 1's top
+h = rings("grazing", center="0.7, 1.9, 0.0", t_end=0.03)
+common("grazing", h)
+if h is not None:
+    ck.record("grazing: ring 2 is pushed up and forward (py > 0 and px of ring 2 > 0 at the end)",
+              h["contacts"].max() > 0)
+
+# a thin shell: radius over thickness 1000
+h = rings("thin_R_h_1000", thickness=0.001, t_end=0.02)
+common("thin_R_h_1000", h)
+
+# ten times the thesis' step: stable with beta 1, gamma 1.5 ...
+h = rings("step_x10_dissipative", dt=5e-4, t_end=0.04)
+common("step_x10_dissipative", h)
+if h is not None:
+    ck.le("step_x10_dissipative: total energy never grows (max E / E0)", h["total"].max() / h["total"][0], 1.0 + 1e-9)
+# ... and with the trapezoidal rule the energy stays within 5% of the initial
+h = rings("step_x10_trapezoidal", dt=5e-4, t_end=0.04, beta=0.25, gamma=0.5)
+common("step_x10_trapezoidal", h)
+if h is not None:
+    ck.le("step_x10_trapezoidal: max E / E0 (bound 1.05)", h["total"].max() / h["total"][0], 1.05)
+
+# Newton failure: a step cut in half and the run recovers
+h = rings("step_cuts", v=100.0, dt=5e-4, t_end=0.01, extra_run=", newton_max_iter = 5")
+common("step_cuts", h)
+if h is not None:
+    steps = np.diff(h["t"])
+    ck.record("step_cuts: some steps were cut and the run went on to the end",
+              steps.min() < 0.75 * 5e-4 and abs(h["t"][-1] - 0.01) < 1e-12,
+              "smallest step %.3g s" % steps.min())
+
+# a long run: 10,000 steps of the two rings, energy and momentum bounded
+h = rings("long_10000_steps", t_end=0.5)
+common("long_10000_steps", h)
+if h is not None:
+    ck.record("long_10000_steps: 10,000 steps", len(h["t"]) - 1 == 10000, str(len(h["t"]) - 1))
+    ck.le("long_10000_steps: total energy never grows (max E / E0)", h["total"].max() / h["total"][0], 1.0 + 1e-9)
+    ck.le("long_10000_steps: energy bounded below (E_end / E0 >= 0.5)", 0.5, h["total"][-1] / h["total"][0])
+
+# a ring dropped on a fixed plate under gravity: bouncing, then resting on many contacts
+deck = os.path.join(work, "drop.nml")
+plate = os.path.join(work, "plate.msh")
+run([casca, "mesh", "plate", "--lx", "3", "--ly", "1", "--nx", "6", "--ny", "2", "-o", plate])
+ring2 = os.path.join(work, "ring_20x2.msh")
+run([casca, "mesh", "ring", "--radius", "1", "--width", "0.2", "--n-around", "20", "--n-across", "2", "-o", ring2])
+with open(deck, "w") as f:
+    f.write(f"""&run dt = 2.0e-4, t_end = 0.6, gravity = 0.0, -9.81, 0.0 /
+&output interval = 0.01, vtu = .false., plots = .false. /
+&body name = 'ring', mesh = 'file', file = '{ring2}', velocity = 0.0, -0.5, 0.0,
+  {STEEL}, thickness = 0.05 /
+&body name = 'plate', mesh = 'file', file = '{plate}', rotate_axis = 1.0, 0.0, 0.0,
+  rotate_angle = -90.0, center = -1.5, -1.01, 0.5, {STEEL}, thickness = 0.05 /
+&restraint body = 'plate', fix = 'all' /
+""")
+out = os.path.join(work, "drop")
+p = run([casca, "run", deck, "--out", out, "-q"])
+ck.record("drop on a plate: runs to the end (exit 0)", p.returncode == 0, p.stderr[-300:])
+if p.returncode == 0:
+    h = history(out)
+    ck.le("drop on a plate: deepest penetration [m]", h["penetration"].max(), 1e-6)
+    ck.le("drop on a plate: no step at the Newton limit (max iterations per step <= 19)",
+          h["newton"].max(), 19)
+    last = h["t"] > 0.5
+    ck.record("drop on a plate: resting at the end on several contacts (>= 3 in the last 0.1 s)",
+              h["contacts"][last].min() >= 3, "min %d" % h["contacts"][last].min())
+    ck.le("drop on a plate: kinetic energy at rest over the largest reached (last 0.1 s)",
+          h["kinetic"][last].max() / h["kinetic"].max(), 0.05)
+ck.finish()
