@@ -6,7 +6,7 @@ module casca_run
   use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs
-  use casca_model, only: model_t, reference_state
+  use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_mumps_solver, only: sparse_solver_t
   use casca_newton, only: newton_opts_t, newton_report_t
@@ -18,6 +18,7 @@ module casca_run
                            contact_penetration, contact_signed_distance, contact_update
   use casca_hdf5_io, only: write_checkpoint, read_checkpoint
   use casca_plots, only: make_plots
+  use casca_free_flight, only: idle_bodies, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks
   use casca_timers, only: timer_start, timer_stop, timer_report, t_account, t_output
   implicit none
@@ -91,7 +92,8 @@ contains
     type(output_t) :: out
     type(contact_t) :: contact
     type(error_t), allocatable :: err
-    real(dp), allocatable :: fext(:), fgrav(:), q0(:)
+    real(dp), allocatable :: fext(:), fgrav(:), q0(:), q_before(:), qd_before(:)
+    logical, allocatable :: frozen(:), idle(:)
     integer, allocatable :: tracked(:), ints(:)
     real(dp), allocatable :: reals(:)
     character(len=128), allocatable :: labels(:)
@@ -182,8 +184,15 @@ contains
       ' bodies, ', model%nelem, ' elements, ', asm%neq, ' unknowns, ', n_ranks, ' rank(s)'
 
     total_newton = 0
+    allocate (frozen(model%ndof), idle(model%nbody))
+    frozen = .false.; idle = .false.
     do while (st%t < deck%run%t_end - 1e-9_dp*dt)
       nm%dt = min(dt/2**level, deck%run%t_end - st%t)
+      if (deck%run%skip_idle_bodies) call update_frozen()
+      if (allocated(err)) then
+        call give_up(err%message); return
+      end if
+      q_before = st%q; qd_before = st%qd
       if (use_contact) then
         call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
       else
@@ -201,6 +210,7 @@ contains
         return
       end if
       total_newton = total_newton + rep%iters
+      if (any(idle)) call advance_idle(model, idle, nm%dt, q_before, qd_before, st%q, st%qd, st%qdd)
       if (level > 0 .and. rep%iters <= 3) level = level - 1   ! Newton is at ease: grow back
       call timer_start(t_account)
       call account(model, asm, st, fext, q0, bal)
@@ -228,6 +238,27 @@ contains
     call finish()
 
   contains
+
+    !> Leave the bodies that need no solving this step out of the equations (re-analysed
+    !> only when that set changes).
+    subroutine update_frozen()
+      logical, allocatable :: fz(:)
+      integer :: b
+      if (use_contact) then
+        call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle, contact)
+      else
+        call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle)
+      end if
+      allocate (fz(model%ndof))
+      fz = .false.
+      do b = 1, model%nbody
+        if (idle(b)) fz(dof(model%body(b)%node_first, 1):dof(model%body(b)%node_last, 7)) = .true.
+      end do
+      if (all(fz .eqv. frozen)) return
+      frozen = fz
+      call assembly_setup(model, asm, err, frozen)
+      call solver%new_pattern()
+    end subroutine update_frozen
 
     subroutine setup_contact()
       integer, allocatable :: pairs(:, :)

@@ -32,6 +32,7 @@ module casca_deck
     integer :: load_steps = 10
     integer :: max_step_cuts = 4
     logical :: reuse_factorisation = .true.     !< modified Newton while it contracts fast
+    logical :: skip_idle_bodies = .true.        !< advance bodies in free flight without solving
     real(dp) :: gravity(3) = 0
     character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
   end type run_cfg_t
@@ -322,15 +323,16 @@ contains
     character(len=16) :: analysis, ordering
     real(dp) :: dt, t_end, beta, gamma, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
-    logical :: reuse_factorisation
+    logical :: reuse_factorisation, skip_idle_bodies
     character(len=256) :: msg
     namelist /run/ title, analysis, dt, t_end, beta, gamma, newton_tol, newton_max_iter, &
-      load_steps, max_step_cuts, gravity, ordering, reuse_factorisation
+      load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies
     associate (c => deck%run)
       title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = c%beta
       gamma = c%gamma; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
       ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
+      skip_idle_bodies = c%skip_idle_bodies
       if (line == 0) return
       rewind (u)
       read (u, nml=run, iostat=ios, iomsg=msg)
@@ -341,6 +343,7 @@ contains
       c%gamma = gamma; c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
       c%ordering = lower(ordering); c%reuse_factorisation = reuse_factorisation
+      c%skip_idle_bodies = skip_idle_bodies
     end associate
   end subroutine read_run
 

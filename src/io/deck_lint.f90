@@ -19,7 +19,7 @@ contains
       case ('title', 'analysis', 'ordering'); t = 's'
       case ('dt', 't_end', 'beta', 'gamma', 'newton_tol', 'gravity'); t = 'r'
       case ('newton_max_iter', 'load_steps', 'max_step_cuts'); t = 'i'
-      case ('reuse_factorisation'); t = 'l'
+      case ('reuse_factorisation', 'skip_idle_bodies'); t = 'l'
       end select
     case ('output')
       select case (key)
@@ -215,7 +215,8 @@ contains
     character(len=:), allocatable :: s
     character(len=*), parameter :: all_keys(*) = [character(len=19) :: 'title', 'analysis', &
       'ordering', 'dt', 't_end', 'beta', 'gamma', 'newton_tol', 'gravity', 'newton_max_iter', &
-      'load_steps', 'max_step_cuts', 'reuse_factorisation', 'dir', 'track_body', 'interval', 'checkpoint_interval', &
+      'load_steps', 'max_step_cuts', 'reuse_factorisation', 'skip_idle_bodies', 'dir', &
+      'track_body', 'interval', 'checkpoint_interval', &
       'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
       'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
       'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &

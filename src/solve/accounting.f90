@@ -31,8 +31,8 @@ contains
     allocate (r(model%ndof))
     call assemble(model, asm, st%q, .false., r, bal%strain)
     s = 0
-    do i = 1, size(asm%elems)
-      e = asm%elems(i)
+    do i = 1, size(asm%owned)   ! every body: frozen ones move too
+      e = asm%owned(i)
       call vectors(st%q, e, x)
       call vectors(st%qd, e, v)
       mv = matmul(v, model%emass(:, :, e))

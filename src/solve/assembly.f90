@@ -16,7 +16,8 @@ module casca_assembly
   type :: assembly_t
     integer :: neq = 0
     integer, allocatable :: eq(:)          !< (ndof) equation number, 0 if prescribed
-    integer, allocatable :: elems(:)       !< this rank's elements
+    integer, allocatable :: elems(:)       !< this rank's elements with unknowns
+    integer, allocatable :: owned(:)       !< this rank's elements for accounting (all bodies)
     integer, allocatable :: estart(:)      !< (size(elems)+1) first entry of each element
     integer, allocatable :: pos(:)         !< element-matrix linear index of each entry
     integer, allocatable :: irn(:), jcn(:) !< equations of each entry (irn >= jcn)
@@ -25,40 +26,49 @@ module casca_assembly
 
 contains
 
-  !> Equation numbering of the free parameters, the element partition (METIS, computed on
-  !> rank 0 and broadcast so that every rank agrees) and this rank's entry pattern.
-  subroutine assembly_setup(model, asm, err)
+  !> Equation numbering of the free parameters (neither prescribed nor frozen), the partition
+  !> of the elements that have unknowns (METIS, computed on rank 0 and broadcast so that every
+  !> rank agrees; the others are dealt round for the accounting) and this rank's pattern.
+  subroutine assembly_setup(model, asm, err, frozen)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(out) :: asm
     type(error_t), allocatable, intent(out) :: err
+    logical, intent(in), optional :: frozen(:)   !< parameters advanced without solving
     integer :: d(ndof_elem), e, k, i, j, n, ia, ib
-    integer, allocatable :: owner(:)
-
-    allocate (owner(model%nelem))
-    owner = 0
-    if (n_ranks > 1) then
-      if (is_root()) then
-        call partition_elements(model%conn, model%nnode, n_ranks, owner, err)
-        if (allocated(err)) owner = -1   ! tell the other ranks, so that none waits forever
-      end if
-      call bcast_int(owner)
-      if (owner(1) < 0) then
-        if (.not. allocated(err)) call fatal_error(err, 'element partition failed on rank 0')
-        return
-      end if
-    end if
+    integer, allocatable :: owner(:), active(:), part(:)
 
     allocate (asm%eq(model%ndof))
     n = 0
     do i = 1, model%ndof
-      if (model%fixed(i)) then
-        asm%eq(i) = 0
-      else
-        n = n + 1; asm%eq(i) = n
+      asm%eq(i) = 0
+      if (model%fixed(i)) cycle
+      if (present(frozen)) then
+        if (frozen(i)) cycle
       end if
+      n = n + 1; asm%eq(i) = n
     end do
     asm%neq = n
-    asm%elems = pack([(e, e=1, model%nelem)], owner == my_rank)
+
+    allocate (owner(model%nelem))
+    active = pack([(e, e=1, model%nelem)], [(any(asm%eq(element_dofs(model, e)) > 0), e=1, model%nelem)])
+    owner = [(mod(e, n_ranks), e=1, model%nelem)]
+    if (n_ranks > 1 .and. size(active) > 0) then
+      allocate (part(size(active)))
+      if (is_root()) then
+        call partition_elements(model%conn(:, active), model%nnode, n_ranks, part, err)
+        if (allocated(err)) part = -1   ! tell the other ranks, so that none waits forever
+      end if
+      call bcast_int(part)
+      if (part(1) < 0) then
+        if (.not. allocated(err)) call fatal_error(err, 'element partition failed on rank 0')
+        return
+      end if
+      owner(active) = part
+    else if (size(active) > 0) then
+      owner(active) = 0
+    end if
+    asm%owned = pack([(e, e=1, model%nelem)], owner == my_rank)
+    asm%elems = pack(active, owner(active) == my_rank)
     allocate (asm%estart(size(asm%elems) + 1))
     ! count, then fill
     k = 0

@@ -36,6 +36,7 @@ module casca_mumps_solver
     procedure :: solve_many => solver_solve_many
     procedure :: negative_pivots => solver_negative_pivots
     procedure :: drop_factors => solver_drop_factors
+    procedure :: new_pattern => solver_new_pattern
     procedure :: finish => solver_finish
   end type sparse_solver_t
 
@@ -161,6 +162,12 @@ contains
     class(sparse_solver_t), intent(inout) :: self
     self%factored = .false.
   end subroutine solver_drop_factors
+
+  !> The unknowns changed: the next solve analyses again.
+  subroutine solver_new_pattern(self)
+    class(sparse_solver_t), intent(inout) :: self
+    self%analysed = .false.; self%factored = .false.
+  end subroutine solver_new_pattern
 
   subroutine solver_finish(self)
     class(sparse_solver_t), intent(inout) :: self

@@ -64,6 +64,10 @@ contains
     logical :: settled, fresh, schur, renew_z
 
     allocate (r(model%ndof), cirn_f(0), cjcn_f(0), cval_f(0))
+    if (asm%neq == 0) then   ! every body is frozen this step: nothing to solve
+      rep%converged = .true.
+      return
+    end if
     schur = .false.
     if (present(contact)) schur = contact%schur
     schur_positive = 0

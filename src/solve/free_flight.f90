@@ -1,0 +1,73 @@
+!> Bodies that need no solving this step: unstressed and unloaded, in uniform translation
+!> (no spin), free of restraints, and with no contact candidate within reach of the step.
+!> Newmark advances such a body exactly by q += dt v with zero acceleration, so casca does
+!> just that and leaves its parameters out of the equations (docs/method.md).
+module casca_free_flight
+  use casca_kinds, only: dp
+  use casca_model, only: model_t, dof
+  use casca_contact, only: contact_t
+  implicit none
+  private
+  public :: idle_bodies, advance_idle
+
+contains
+
+  !> idle(b) for every body. contact may be absent (no pairs).
+  subroutine idle_bodies(model, q, qd, qdd, fext, dt, idle, contact)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:), qd(:), qdd(:), fext(:), dt
+    logical, intent(out) :: idle(:)
+    type(contact_t), intent(in), optional :: contact
+    real(dp) :: lo(3, model%nbody), hi(3, model%nbody), speed(model%nbody), reach
+    real(dp) :: shift(3), v(3), tol
+    integer :: b, n, k, i, j, f, l
+    tol = 1e-12_dp*model%length
+    do b = 1, model%nbody
+      associate (bd => model%body(b))
+        f = dof(bd%node_first, 1); l = dof(bd%node_last, 7)
+        lo(:, b) = huge(1._dp); hi(:, b) = -huge(1._dp)
+        idle(b) = .not. any(model%fixed(f:l)) .and. all(fext(f:l) == 0) .and. all(qdd(f:l) == 0)
+        shift = q(dof(bd%node_first, 1):dof(bd%node_first, 3)) - model%x0(:, bd%node_first)
+        v = qd(dof(bd%node_first, 1):dof(bd%node_first, 3))
+        speed(b) = norm2(v)
+        do n = bd%node_first, bd%node_last
+          lo(:, b) = min(lo(:, b), q(dof(n, 1):dof(n, 3)))
+          hi(:, b) = max(hi(:, b), q(dof(n, 1):dof(n, 3)))
+          if (.not. idle(b)) cycle
+          idle(b) = all(abs(q(dof(n, 1):dof(n, 3)) - model%x0(:, n) - shift) <= tol) .and. &
+                    all(abs(q(dof(n, 4):dof(n, 6)) - model%v0(:, n)) <= 1e-12_dp) .and. &
+                    abs(q(dof(n, 7))) <= 1e-12_dp .and. &
+                    all(qd(dof(n, 1):dof(n, 3)) == v) .and. all(qd(dof(n, 4):dof(n, 7)) == 0)
+        end do
+      end associate
+    end do
+    if (.not. present(contact)) return
+    do k = 1, contact%nact   ! bodies in contact
+      i = model%node_body(contact%act(k)%node)
+      idle(i) = .false.; idle(contact%pair(2, contact%act(k)%pair)) = .false.
+    end do
+    do k = 1, contact%npairs  ! boxes that could meet within two steps
+      i = contact%pair(1, k); j = contact%pair(2, k)
+      reach = contact%depth(j) + 2*dt*(speed(i) + speed(j))
+      if (all(lo(:, i) <= hi(:, j) + reach) .and. all(hi(:, i) >= lo(:, j) - reach)) then
+        idle(i) = .false.; idle(j) = .false.
+      end if
+    end do
+  end subroutine idle_bodies
+
+  !> The exact Newmark step of an idle body: q += dt v, v kept, acceleration zero.
+  pure subroutine advance_idle(model, idle, dt, q_before, qd_before, q, qd, qdd)
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: idle(:)
+    real(dp), intent(in) :: dt, q_before(:), qd_before(:)
+    real(dp), intent(inout) :: q(:), qd(:), qdd(:)
+    integer :: b, f, l
+    do b = 1, model%nbody
+      if (.not. idle(b)) cycle
+      f = dof(model%body(b)%node_first, 1); l = dof(model%body(b)%node_last, 7)
+      q(f:l) = q_before(f:l) + dt*qd_before(f:l)
+      qd(f:l) = qd_before(f:l)
+      qdd(f:l) = 0
+    end do
+  end subroutine advance_idle
+end module casca_free_flight
