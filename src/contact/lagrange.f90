@@ -9,6 +9,7 @@ module casca_contact
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_shape_tri10, only: tri10_shape
+  use casca_vectors, only: cross
   use casca_surface_search, only: surface_t, grid_t, surface_init, grid_build, &
                                   nearest_subtriangle, surface_box, subtri_parent_xi
   implicit none
@@ -394,9 +395,4 @@ contains
     end do
   end function positions
 
-  pure function cross(a, b) result(v)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: v(3)
-    v = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end module casca_contact

@@ -13,6 +13,7 @@ module casca_shell_element
   use casca_error, only: error_t, fatal_error
   use casca_shape_tri10, only: tri10_shape
   use casca_quadrature, only: triangle_rule, gauss_rule
+  use casca_vectors, only: cross
   implicit none
   private
   public :: shell_rule_t, shell_rule_init, shell_reference, shell_energy_force, shell_mass
@@ -279,9 +280,9 @@ contains
     a1(:, 2) = matmul(q(1:3, :), dphi(:, 2))
     a1(:, 3) = 0.5_dp*h*g          ! at xi3 = 0 the thickness parameter only enters d/dxi3
     d = det3(a0)
-    inv(:, 1) = cross3(a0(:, 2), a0(:, 3))/d   ! rows of A0^-1, stored as columns
-    inv(:, 2) = cross3(a0(:, 3), a0(:, 1))/d
-    inv(:, 3) = cross3(a0(:, 1), a0(:, 2))/d
+    inv(:, 1) = cross(a0(:, 2), a0(:, 3))/d   ! rows of A0^-1, stored as columns
+    inv(:, 2) = cross(a0(:, 3), a0(:, 1))/d
+    inv(:, 3) = cross(a0(:, 1), a0(:, 2))/d
     f = matmul(a1, transpose(inv))
     e = 0.5_dp*matmul(transpose(f), f)
     do i = 1, 3
@@ -297,11 +298,6 @@ contains
               + 3*(sig(1, 2)**2 + sig(2, 3)**2 + sig(1, 3)**2))
   end function shell_von_mises
 
-  pure function cross3(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross3
 
   !> Constant consistent mass of one element from the part of the map linear in (Y, G):
   !> y_K = phi_l Y^l + h/2 xi3 phi_l G^l. m(p, q) is the scalar mass between vector

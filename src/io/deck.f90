@@ -10,7 +10,7 @@
 module casca_deck
   use, intrinsic :: iso_fortran_env, only: iostat_end
   use casca_kinds, only: dp
-  use casca_deck_lint, only: lint_group
+  use casca_deck_lint, only: lint_group, lower
   implicit none
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
@@ -411,13 +411,4 @@ contains
     end associate
   end subroutine read_contact
 
-  pure function lower(s) result(t)
-    character(len=*), intent(in) :: s
-    character(len=len(s)) :: t
-    integer :: i
-    t = s
-    do i = 1, len(s)
-      if (s(i:i) >= 'A' .and. s(i:i) <= 'Z') t(i:i) = achar(iachar(s(i:i)) + 32)
-    end do
-  end function lower
 end module casca_deck

@@ -4,7 +4,7 @@
 module casca_deck_lint
   implicit none
   private
-  public :: lint_group, key_type
+  public :: lint_group, key_type, lower
 
 contains
 

@@ -33,6 +33,7 @@ module casca_hdf5_io
                   H5T_STD_I32LE, h5lexists_f
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
+  use casca_files, only: rename_file
   implicit none
   private
   public :: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, h5_table_close, &
@@ -57,14 +58,6 @@ module casca_hdf5_io
 
   logical, save :: h5_ready = .false.
 
-  interface
-    !> C library rename(): Fortran 2008 has no standard way to rename a file.
-    function c_rename(old, new) bind(c, name='rename') result(stat)
-      import :: c_char, c_int
-      character(kind=c_char), intent(in) :: old(*), new(*)
-      integer(c_int) :: stat
-    end function c_rename
-  end interface
 
 contains
 
@@ -372,7 +365,7 @@ contains
       call delete_file(tmp)
       return
     end if
-    if (c_rename(tmp//c_null_char, path//c_null_char) /= 0) then
+    if (.not. rename_file(tmp, path)) then
       call fatal_error(err, who//': cannot rename '//tmp//' to '//path)
       call delete_file(tmp)
       return

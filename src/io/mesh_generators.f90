@@ -11,6 +11,7 @@ module casca_mesh_generators
   use casca_kinds, only: dp, pi
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
+  use casca_vectors, only: cross
   implicit none
   private
   public :: mesh_ring, mesh_sphere, mesh_plate
@@ -301,9 +302,4 @@ contains
     end function is_edge
   end subroutine icosahedron
 
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end module casca_mesh_generators

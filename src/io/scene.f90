@@ -10,6 +10,7 @@ module casca_scene
   use casca_sanity, only: parse_fix
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
   use casca_newmark, only: state_t
+  use casca_vectors, only: cross
   implicit none
   private
   public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs
@@ -220,9 +221,4 @@ contains
     end do
   end subroutine tracked_nodes
 
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end module casca_scene

@@ -15,6 +15,7 @@ module casca_vtu_writer
   use, intrinsic :: iso_fortran_env, only: int8, int32, int64
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
+  use casca_files, only: rename_file
   implicit none
   private
   public :: field_t, field, write_vtu, write_pvd
@@ -34,14 +35,6 @@ module casca_vtu_writer
     module procedure itoa_i32, itoa_i64
   end interface itoa
 
-  interface
-    !> C library rename(): Fortran 2008 has no standard way to rename a file.
-    function c_rename(old, new) bind(c, name='rename') result(stat)
-      import :: c_char, c_int
-      character(kind=c_char), intent(in) :: old(*), new(*)
-      integer(c_int) :: stat
-    end function c_rename
-  end interface
 
 contains
 
@@ -224,7 +217,7 @@ contains
       call fatal_error(err, who//': error closing '//tmp//': '//trim(msg))
       return
     end if
-    if (c_rename(tmp//c_null_char, path//c_null_char) /= 0) then
+    if (.not. rename_file(tmp, path)) then
       ! Do not leave the complete-looking temporary behind.
       open (newunit=tmp_unit, file=tmp, status='old', iostat=ios)
       if (ios == 0) close (tmp_unit, status='delete', iostat=ios)

@@ -5,6 +5,7 @@ module casca_model
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
+  use casca_vectors, only: cross
   use casca_shape_tri10, only: tri10_shape, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, shell_mass, &
                                  svk_lame, ndof_node
@@ -169,9 +170,4 @@ contains
     end do
   end subroutine reference_state
 
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end module casca_model

@@ -6,6 +6,7 @@ module casca_accounting
   use casca_assembly, only: assembly_t, assemble
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
+  use casca_vectors, only: cross
   implicit none
   private
   public :: balance_t, account, gravity_load
@@ -78,9 +79,4 @@ contains
     end do
   end subroutine gravity_load
 
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end module casca_accounting

@@ -19,6 +19,7 @@ module casca_newton
   use casca_contact, only: contact_t, contact_update, contact_release, contact_rows
   use casca_mpi, only: is_root, bcast_real, bcast_int
   use casca_metis, only: nested_dissection
+  use casca_lapack, only: dsyev, dgetrf, dgetrs
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve
   implicit none

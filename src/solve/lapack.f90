@@ -1,0 +1,32 @@
+!> Explicit interfaces of the few LAPACK routines casca calls (the library ships none).
+module casca_lapack
+  use casca_kinds, only: dp
+  implicit none
+  private
+  public :: dsyev, dgetrf, dgetrs
+
+  interface
+    subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
+      import :: dp
+      character, intent(in) :: jobz, uplo
+      integer, intent(in) :: n, lda, lwork
+      real(dp), intent(inout) :: a(lda, *)
+      real(dp), intent(out) :: w(*), work(*)
+      integer, intent(out) :: info
+    end subroutine dsyev
+    subroutine dgetrf(m, n, a, lda, ipiv, info)
+      import :: dp
+      integer, intent(in) :: m, n, lda
+      real(dp), intent(inout) :: a(lda, *)
+      integer, intent(out) :: ipiv(*), info
+    end subroutine dgetrf
+    subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+      import :: dp
+      character, intent(in) :: trans
+      integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+      real(dp), intent(in) :: a(lda, *)
+      real(dp), intent(inout) :: b(ldb, *)
+      integer, intent(out) :: info
+    end subroutine dgetrs
+  end interface
+end module casca_lapack
