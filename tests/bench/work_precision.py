@@ -152,7 +152,7 @@ with open(os.path.join(work, "work_precision.dat"), "w") as f:
     for r in rows:
         f.write("%s %s %.3e %d %.4e %.3f %d\n" % r)
 scenes = sorted(set(r[0] for r in rows))
-plot = ["set terminal pngcairo size 1000,650", "set output 'work_precision.png'", "set logscale xy",
+plot = ["set terminal pngcairo size 1000,650 noenhanced", "set output 'work_precision.png'", "set logscale xy",
         "set xlabel 'wall time [s]'", "set ylabel 'error (strip: relative; rings, spheres: m)'",
         "set grid", "set key outside right",
         "set title 'casca: error against wall time (%d rank%s)'" % (args.ranks, "s" if args.ranks > 1 else "")]
