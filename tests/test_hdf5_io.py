@@ -19,22 +19,19 @@ import tempfile
 
 import numpy as np
 import h5py
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from casca_testlib import Checks  # noqa: E402
 
 # Must match tests/test_hdf5_io.f90.
 NCOL, NROWS, NKEEP, NMORE = 5, 1000, 600, 10
 COLUMNS = ["time", "energy_kin", "energy_pot", "u_tip", "n_contact"]
 FILES = ["hdf5_io_table.h5", "hdf5_io_restart.h5", "hdf5_io_ckpt.h5", "hdf5_io_not_h5.txt"]
 
-results = {"passed": 0, "failed": 0}
+CK = Checks()
 
 
 def check(ok, what):
-    if ok:
-        results["passed"] += 1
-        print(f"PASS {what}")
-    else:
-        results["failed"] += 1
-        print(f"FAIL {what}")
+    CK.record(what, ok)
     return ok
 
 
@@ -114,7 +111,7 @@ def main():
     sys.stdout.write(run.stdout)
     sys.stderr.write(run.stderr)
     if not check(run.returncode == 0, f"{os.path.basename(exe)} exits 0 (got {run.returncode})"):
-        print(f"{results['passed']} passed, {results['failed']} failed")
+        print(f"{CK.passed} passed, {CK.failed} failed")
         return 1
 
     leftovers = [f for f in os.listdir(outdir) if f.endswith(".part")]
@@ -127,8 +124,8 @@ def main():
                            expected(range(NKEEP + 1, NKEEP + NMORE + 1), -1.0)]))
     check_checkpoint(os.path.join(outdir, "hdf5_io_ckpt.h5"))
 
-    print(f"{results['passed']} passed, {results['failed']} failed")
-    return 0 if results["failed"] == 0 else 1
+    print(f"{CK.passed} passed, {CK.failed} failed")
+    return 0 if CK.failed == 0 else 1
 
 
 if __name__ == "__main__":

@@ -22,6 +22,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import meshio
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from casca_testlib import Checks  # noqa: E402
 
 NEN = 10
 # Must match tests/test_vtu.f90.
@@ -33,16 +35,11 @@ FILES = ["cyl_0000.vtu", "cyl_0001.vtu"]
 XI_REF = [(0, 0), (1, 0), (0, 1), (1 / 3, 0), (2 / 3, 0), (2 / 3, 1 / 3), (1 / 3, 2 / 3),
           (0, 2 / 3), (0, 1 / 3), (1 / 3, 1 / 3)]
 
-results = {"passed": 0, "failed": 0}
+CK = Checks()
 
 
 def check(ok, what):
-    if ok:
-        results["passed"] += 1
-        print(f"ok   {what}")
-    else:
-        results["failed"] += 1
-        print(f"FAIL {what}")
+    CK.record(what, ok)
     return ok
 
 
@@ -213,7 +210,7 @@ def main():
     sys.stdout.write(run.stdout)
     sys.stderr.write(run.stderr)
     if not check(run.returncode == 0, f"{os.path.basename(exe)} exits 0 (got {run.returncode})"):
-        print(f"{results['passed']} passed, {results['failed']} failed")
+        print(f"{CK.passed} passed, {CK.failed} failed")
         return 1
 
     leftovers = [f for f in os.listdir(outdir) if f.endswith(".part")]
@@ -239,8 +236,8 @@ def main():
     for i, d in enumerate(datasets):
         check_vtu(os.path.join(outdir, d.get("file")), i + 1, samples)
 
-    print(f"{results['passed']} passed, {results['failed']} failed")
-    return 0 if results["failed"] == 0 else 1
+    print(f"{CK.passed} passed, {CK.failed} failed")
+    return 0 if CK.failed == 0 else 1
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ module casca_files
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
   implicit none
   private
-  public :: rename_file
+  public :: rename_file, delete_file
 
   interface
     function c_rename(old, new) bind(c, name='rename') result(stat)
@@ -21,4 +21,12 @@ contains
     character(len=*), intent(in) :: old, new
     rename_file = c_rename(old//c_null_char, new//c_null_char) == 0
   end function rename_file
+
+  !> Remove a file if it exists (a failed .part).
+  subroutine delete_file(path)
+    character(len=*), intent(in) :: path
+    integer :: u, ios
+    open (newunit=u, file=path, status='old', iostat=ios)
+    if (ios == 0) close (u, status='delete', iostat=ios)
+  end subroutine delete_file
 end module casca_files

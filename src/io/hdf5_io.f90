@@ -33,7 +33,7 @@ module casca_hdf5_io
                   H5T_STD_I32LE, h5lexists_f
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_files, only: rename_file
+  use casca_files, only: rename_file, delete_file
   implicit none
   private
   public :: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, h5_table_close, &
@@ -696,14 +696,6 @@ contains
     if (dset /= -1) call h5dclose_f(dset, h)
     if (fid /= -1) call h5fclose_f(fid, h)
   end subroutine abandon
-
-  !> Remove a file if it exists (used for a failed .part).
-  subroutine delete_file(path)
-    character(len=*), intent(in) :: path
-    integer :: u, ios
-    open (newunit=u, file=path, status='old', iostat=ios)
-    if (ios == 0) close (u, status='delete', iostat=ios)
-  end subroutine delete_file
 
   pure function itoa(n) result(s)
     integer(hsize_t), intent(in) :: n
