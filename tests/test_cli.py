@@ -78,6 +78,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("degenerate element", lambda s: s.replace(ring, flat_msh, 1), ["degenerate", "ring1"]),
     ("restraint selects no node", lambda s: s + "&restraint\n body = 'ring2', box_min = 50.0, 50.0, 50.0, fix = 'y'\n/\n",
      ["&restraint", "no node", "ring2"]),
+    ("node set out of range", lambda s: s + "&restraint\n body = 'ring2', nodes = 1, 2, 999, fix = 'y'\n/\n",
+     ["&restraint", "nodes(3) = 999", "out of range 1..240"]),
     ("unknown body in a restraint", lambda s: s + "&restraint\n body = 'ring9', fix = 'y'\n/\n", ["ring9", "not a body"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.01", "center = 1.99"),
@@ -99,6 +101,12 @@ for name, change, needles in cases:
     ck.record("bad deck, %s: exit 2 and a message naming it" % name, ok,
               "exit %d: %s" % (p.returncode, msg.strip().splitlines()[0] if msg.strip() else ""))
 ck.record("no output folder was made for bad decks", not os.path.exists(os.path.join(work, "bad_out")))
+nodeset = os.path.join(work, "nodeset.nml")
+with open(nodeset, "w") as f:
+    f.write(good + "&restraint\n body = 'ring2', nodes = 1, 2, 240, fix = 'y'\n/\n")
+p = run([casca, "check", nodeset])
+ck.record("a node set within range is accepted (casca check: exit 0, 3 fewer unknowns)",
+          p.returncode == 0 and "3357 unknowns" in p.stdout, p.stdout.strip() + p.stderr.strip())
 
 # --- a short two-ring run: frames, collection, history in two formats
 deck = os.path.join(work, "good.nml")

@@ -2,8 +2,8 @@
 !>   &run        analysis, time step, end time, Newmark and Newton parameters, gravity
 !>   &output     folder, frame interval, tracked points, checkpoint interval
 !>   &body       (one per body) mesh or generator, material, thickness, initial motion
-!>   &restraint  (any number) prescribed parameters of the nodes of a body inside a box
-!>   &load       (any number) a dead force shared by the nodes of a body inside a box
+!>   &restraint  (any number) prescribed parameters of a body's nodes: a box or a node set
+!>   &load       (any number) a dead force shared by a body's nodes: a box or a node set
 !>   &contact    contact pairs and tolerances
 !> Every problem found while reading is collected (file:line: group: message) so that the
 !> user sees them all at once; nothing here stops the program.
@@ -18,6 +18,7 @@ module casca_deck
 
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
+  integer, parameter :: max_set = 512            !< nodes listed in one restraint or load
   real(dp), parameter :: unset = -huge(1._dp)   !< marks a value the deck did not give
   character(len=*), parameter :: known_groups(7) = &
     [character(len=9) :: 'run', 'output', 'body', 'restraint', 'load', 'contact', 'end']
@@ -65,6 +66,7 @@ module casca_deck
   type :: restraint_cfg_t
     character(len=64) :: body = ''
     real(dp) :: box_min(3) = -huge(1._dp), box_max(3) = huge(1._dp)
+    integer, allocatable :: nodes(:)            !< node numbers in the body (a node set)
     character(len=64) :: fix = 'clamped'
     integer :: line = 0
   end type restraint_cfg_t
@@ -72,6 +74,7 @@ module casca_deck
   type :: load_cfg_t
     character(len=64) :: body = ''
     real(dp) :: box_min(3) = -huge(1._dp), box_max(3) = huge(1._dp)
+    integer, allocatable :: nodes(:)            !< node numbers in the body (a node set)
     real(dp) :: force(3) = 0                    !< total, shared equally by the nodes
     integer :: line = 0
   end type load_cfg_t
@@ -227,19 +230,21 @@ contains
       type(deck_t), intent(inout) :: dk
       character(len=64) :: body, fix
       real(dp) :: box_min(3), box_max(3)
-      namelist /restraint/ body, box_min, box_max, fix
+      integer :: nodes(max_set)
+      namelist /restraint/ body, box_min, box_max, fix, nodes
       type(restraint_cfg_t) :: r
       integer :: ir
       rewind (uu)
       do ir = 1, count(gname == 'restraint')
         r = restraint_cfg_t()
-        body = r%body; fix = r%fix; box_min = r%box_min; box_max = r%box_max
+        body = r%body; fix = r%fix; box_min = r%box_min; box_max = r%box_max; nodes = 0
         read (uu, nml=restraint, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('restraint', ir), '&restraint: '//trim(msg))
           return
         end if
         r%body = body; r%fix = fix; r%box_min = box_min; r%box_max = box_max
+        r%nodes = pack(nodes, nodes /= 0)
         r%line = line_of('restraint', ir)
         dk%restraints = [dk%restraints, r]
       end do
@@ -250,19 +255,21 @@ contains
       type(deck_t), intent(inout) :: dk
       character(len=64) :: body
       real(dp) :: box_min(3), box_max(3), force(3)
-      namelist /load/ body, box_min, box_max, force
+      integer :: nodes(max_set)
+      namelist /load/ body, box_min, box_max, force, nodes
       type(load_cfg_t) :: l
       integer :: il
       rewind (uu)
       do il = 1, count(gname == 'load')
         l = load_cfg_t()
-        body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force
+        body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force; nodes = 0
         read (uu, nml=load, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('load', il), '&load: '//trim(msg))
           return
         end if
         l%body = body; l%box_min = box_min; l%box_max = box_max; l%force = force
+        l%nodes = pack(nodes, nodes /= 0)
         l%line = line_of('load', il)
         dk%loads = [dk%loads, l]
       end do

@@ -38,11 +38,13 @@ contains
       select case (key)
       case ('body', 'fix'); t = 's'
       case ('box_min', 'box_max'); t = 'r'
+      case ('nodes'); t = 'i'
       end select
     case ('load')
       select case (key)
       case ('body'); t = 's'
       case ('box_min', 'box_max', 'force'); t = 'r'
+      case ('nodes'); t = 'i'
       end select
     case ('contact')
       select case (key)
@@ -220,7 +222,7 @@ contains
       'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
       'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
       'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &
-      'force', 'pairs', 'tolerance', 'enabled', 'solver']
+      'force', 'pairs', 'tolerance', 'enabled', 'solver', 'nodes']
     integer :: i, d, best
     s = ''
     best = 3

@@ -105,6 +105,8 @@ contains
       associate (r => deck%restraints(i))
         if (r%body /= '' .and. find_body(r%body) == 0) call add_problem(deck, r%line, &
           '&restraint: body = '''//trim(r%body)//''' is not a body of the deck')
+        if (size(r%nodes) > 0 .and. r%body == '') call add_problem(deck, r%line, &
+          '&restraint: nodes needs body = ... (node numbers count within a body)')
         call parse_fix(r%fix, comps, ok)
         if (.not. ok) call add_problem(deck, r%line, '&restraint: fix = '''//trim(r%fix)// &
           ''' (use clamped, pinned, all, or components among x y z gx gy gz a)')
@@ -116,6 +118,8 @@ contains
       associate (l => deck%loads(i))
         if (l%body /= '' .and. find_body(l%body) == 0) call add_problem(deck, l%line, &
           '&load: body = '''//trim(l%body)//''' is not a body of the deck')
+        if (size(l%nodes) > 0 .and. l%body == '') call add_problem(deck, l%line, &
+          '&load: nodes needs body = ... (node numbers count within a body)')
         if (any(l%box_min > l%box_max)) call add_problem(deck, l%line, &
           '&load: box_min must not exceed box_max')
       end associate

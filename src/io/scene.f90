@@ -93,7 +93,8 @@ contains
 
     do i = 1, size(deck%restraints)
       associate (r => deck%restraints(i))
-        sel = select_nodes(r%body, r%box_min, r%box_max)
+        if (.not. node_set('&restraint', r%body, r%nodes, r%line, sel)) cycle
+        if (size(r%nodes) == 0) sel = select_nodes(r%body, r%box_min, r%box_max)
         if (size(sel) == 0) then
           call add_problem(deck, r%line, '&restraint: no node of '//body_label(r%body)// &
                            ' lies inside box_min..box_max'); cycle
@@ -106,7 +107,8 @@ contains
     end do
     do i = 1, size(deck%loads)
       associate (l => deck%loads(i))
-        sel = select_nodes(l%body, l%box_min, l%box_max)
+        if (.not. node_set('&load', l%body, l%nodes, l%line, sel)) cycle
+        if (size(l%nodes) == 0) sel = select_nodes(l%body, l%box_min, l%box_max)
         nsel = size(sel)
         if (nsel == 0) then
           call add_problem(deck, l%line, '&load: no node of '//body_label(l%body)// &
@@ -120,6 +122,30 @@ contains
     end do
     model%gravity = deck%run%gravity
   contains
+    !> the model's numbers of a node set given within a body; .false. (and a problem) when a
+    !> number is out of range
+    logical function node_set(group, body, nodes, line, s)
+      character(len=*), intent(in) :: group, body
+      integer, intent(in) :: nodes(:), line
+      integer, allocatable, intent(out) :: s(:)
+      integer :: kb, k, n
+      character(len=160) :: msg
+      node_set = .true.
+      allocate (s(0))
+      if (size(nodes) == 0) return
+      kb = findloc([(model%body(k)%name == body, k=1, model%nbody)], .true., dim=1)
+      n = model%body(kb)%node_last - model%body(kb)%node_first + 1
+      do k = 1, size(nodes)
+        if (nodes(k) < 1 .or. nodes(k) > n) then
+          write (msg, '(a,a,i0,a,i0,a,i0,a)') group, ': nodes(', k, ') = ', nodes(k), &
+            ' is out of range 1..', n, ' of body '''//trim(body)//''''
+          call add_problem(deck, line, trim(msg))
+          node_set = .false.
+        end if
+      end do
+      if (node_set) s = nodes + model%body(kb)%node_first - 1
+    end function node_set
+
     function select_nodes(body, lo, hi) result(s)
       character(len=*), intent(in) :: body
       real(dp), intent(in) :: lo(3), hi(3)
