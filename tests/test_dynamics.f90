@@ -15,6 +15,7 @@ program test_dynamics
   use casca_newmark, only: state_t, newmark_t, newmark_step
   use casca_accounting, only: balance_t, account
   use casca_mpi, only: mpi_start, mpi_stop, is_root, n_ranks
+  use casca_vectors, only: cross
   use casca_check, only: check_le, check_close, check_true, check_summary
   implicit none
 
@@ -178,9 +179,4 @@ contains
     if (present(qout)) qout = st%q
   end subroutine free_flight
 
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end program test_dynamics

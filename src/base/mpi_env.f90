@@ -1,14 +1,14 @@
 !> The only place MPI is set up: rank, size, and the few collectives casca uses.
 module casca_mpi
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_SUM, &
-                     MPI_MAX, MPI_LOGICAL, MPI_LOR, mpi_init, mpi_finalize, mpi_comm_rank, &
+                     mpi_init, mpi_finalize, mpi_comm_rank, &
                      mpi_comm_size, mpi_initialized, mpi_finalized, mpi_wtime, mpi_allreduce, &
                      mpi_bcast
   use casca_kinds, only: dp
   implicit none
   private
   public :: mpi_start, mpi_stop, comm, comm_handle, my_rank, n_ranks, is_root, wall_time
-  public :: sum_all, max_all, any_all, bcast_real, bcast_int
+  public :: sum_all, bcast_real, bcast_int
 
   type(MPI_Comm), protected :: comm
   integer, protected :: my_rank = 0
@@ -21,6 +21,10 @@ module casca_mpi
   interface bcast_real
     module procedure bcast_r1, bcast_r0
   end interface bcast_real
+
+  interface bcast_int
+    module procedure bcast_i1, bcast_i0
+  end interface bcast_int
 
 contains
 
@@ -73,25 +77,7 @@ contains
     x = y(1)
   end subroutine sum_all_r0
 
-  real(dp) function max_all(x)
-    real(dp), intent(in) :: x
-    real(dp) :: y(1)
-    integer :: ierr
-    max_all = x
-    if (n_ranks == 1) return
-    call mpi_allreduce([x], y, 1, MPI_DOUBLE_PRECISION, MPI_MAX, comm, ierr)
-    max_all = y(1)
-  end function max_all
 
-  logical function any_all(x)
-    logical, intent(in) :: x
-    logical :: y(1)
-    integer :: ierr
-    any_all = x
-    if (n_ranks == 1) return
-    call mpi_allreduce([x], y, 1, MPI_LOGICAL, MPI_LOR, comm, ierr)
-    any_all = y(1)
-  end function any_all
 
   !> Broadcast from rank 0.
   subroutine bcast_r1(x)
@@ -110,9 +96,18 @@ contains
     x = y(1)
   end subroutine bcast_r0
 
-  subroutine bcast_int(x)
+  subroutine bcast_i1(x)
     integer, intent(inout) :: x(:)
     integer :: ierr
     if (n_ranks > 1) call mpi_bcast(x, size(x), MPI_INTEGER, 0, comm, ierr)
-  end subroutine bcast_int
+  end subroutine bcast_i1
+
+  subroutine bcast_i0(x)
+    integer, intent(inout) :: x
+    integer :: y(1)
+    if (n_ranks == 1) return
+    y(1) = x
+    call bcast_i1(y)
+    x = y(1)
+  end subroutine bcast_i0
 end module casca_mpi

@@ -11,7 +11,7 @@ module casca_contact
   use casca_shape_tri10, only: tri10_shape
   use casca_vectors, only: cross
   use casca_surface_search, only: surface_t, grid_t, surface_init, grid_build, &
-                                  nearest_subtriangle, surface_box, subtri_parent_xi
+                                  nearest_subtriangle, subtri_parent_xi
   implicit none
   private
   public :: contact_t, contact_init, contact_update, contact_release, contact_rows

@@ -4,7 +4,7 @@
 module casca_deck_lint
   implicit none
   private
-  public :: lint_group, key_type, lower
+  public :: lint_group, lower
 
 contains
 

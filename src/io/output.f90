@@ -15,7 +15,7 @@ module casca_output
   use casca_mpi, only: is_root
   implicit none
   private
-  public :: output_t, output_open, output_history, output_frame, output_close, history_columns
+  public :: output_t, output_open, output_history, output_frame, output_close
 
   type :: output_t
     character(len=:), allocatable :: dir

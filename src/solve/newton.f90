@@ -247,16 +247,9 @@ contains
       end if
       call bcast_real(x)
       schur_positive = contact%z_positive
-      call bcast_int_scalar(schur_positive)
+      call bcast_int(schur_positive)
     end subroutine schur_solve
 
-    subroutine bcast_int_scalar(i)
-      integer, intent(inout) :: i
-      integer :: v(1)
-      v(1) = i
-      call bcast_int(v)
-      i = v(1)
-    end subroutine bcast_int_scalar
 
     !> symbolic analysis at the first solve and whenever the constraint rows change
     subroutine analyse_if_needed()
