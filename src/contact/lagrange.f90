@@ -14,7 +14,7 @@ module casca_contact
                                   nearest_subtriangle, subtri_parent_xi
   implicit none
   private
-  public :: contact_t, contact_init, contact_update, contact_release, contact_rows
+  public :: contact_t, constraint_t, contact_init, contact_update, contact_release, contact_rows
   public :: contact_penetration, contact_force_total, contact_nodal_fields, contact_signed_distance
   public :: contact_persistency
 
@@ -29,8 +29,8 @@ module casca_contact
     integer :: npairs = 0
     integer, allocatable :: pair(:, :)          !< (2, npairs) impactor body, target body
     type(surface_t), allocatable :: surf(:)     !< per body (only targets are built)
-    type(grid_t), allocatable :: grid(:)
-    logical, allocatable :: grid_ok(:)          !< grid of this body rebuilt for this q
+    type(grid_t), allocatable :: grid(:)        !< per pair: the target near the impactor
+    logical, allocatable :: grid_ok(:)          !< grid of this pair rebuilt for this q
     real(dp), allocatable :: depth(:)           !< per body: deepest signed distance taken as penetration
     real(dp) :: tol = 0                         !< penetration accepted [m]
     integer :: nact = 0
@@ -39,10 +39,11 @@ module casca_contact
     integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
     real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
     logical :: schur = .true.                   !< solve through the Schur complement of K
-    ! Schur cache (rank 0): Z = K^-1 C^T and S = C Z for the rows (z_irn, z_jcn, z_val) and
-    ! the factorisation z_factor of K they were computed with
+    ! Schur cache: Z = K^-1 C^T (group hosts, their block) and S = C Z (LU, every rank) for
+    ! the constraints (z_node, z_elem), their rows (z_irn, z_jcn, z_val) and the
+    ! factorisation z_factor of K they were computed with
     real(dp), allocatable :: z(:, :), s(:, :)
-    integer, allocatable :: z_irn(:), z_jcn(:), z_ipiv(:)
+    integer, allocatable :: z_irn(:), z_jcn(:), z_ipiv(:), z_node(:), z_elem(:)
     real(dp), allocatable :: z_val(:)
     integer :: z_factor = -1
     integer :: z_positive = 0                   !< positive eigenvalues of S
@@ -61,7 +62,7 @@ contains
     c%npairs = size(pairs, 2)
     c%pair = pairs
     c%tol = tol
-    allocate (c%surf(model%nbody), c%grid(model%nbody), c%grid_ok(model%nbody), &
+    allocate (c%surf(model%nbody), c%grid(c%npairs), c%grid_ok(c%npairs), &
               c%depth(model%nbody), c%act(16))
     c%grid_ok = .false.; c%depth = 0
     ! the mass a unit change of a node's velocity adds to the momentum: t^T M e_i
@@ -178,13 +179,15 @@ contains
       real(dp), intent(out) :: sdist
       logical, intent(out) :: ok
       integer :: b, itri, region
-      real(dp) :: xq(3), bary(3), dist, nt(3)
+      real(dp) :: xq(3), bary(3), dist, nt(3), near(3, 2)
       b = c%pair(2, p)
-      if (.not. c%grid_ok(b)) then
-        call grid_build(c%surf(b), x, c%grid(b))
-        c%grid_ok(b) = .true.
+      if (.not. c%grid_ok(p)) then   ! the target's sub-triangles within reach of the impactor
+        near = box_of(c%pair(1, p))
+        near(:, 1) = near(:, 1) - c%depth(b); near(:, 2) = near(:, 2) + c%depth(b)
+        call grid_build(c%surf(b), x, c%grid(p), near)
+        c%grid_ok(p) = .true.
       end if
-      call nearest_subtriangle(c%surf(b), c%grid(b), x, x(:, node), c%depth(b), ok, itri, xq, &
+      call nearest_subtriangle(c%surf(b), c%grid(p), x, x(:, node), c%depth(b), ok, itri, xq, &
                                bary, dist, region)
       sdist = huge(1._dp)
       if (.not. ok) return
@@ -319,15 +322,14 @@ contains
   !> Deepest penetration of the impactor nodes that carry no constraint (signed distance to
   !> the sub-triangles) and largest |gap| of those that do.
   subroutine contact_penetration(c, model, q, free_pen, max_gap)
-    type(contact_t), intent(inout) :: c
+    type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     real(dp), intent(out) :: free_pen, max_gap
     type(contact_t) :: probe
     integer :: added, k
-    ! a copy with no active constraint and zero tolerance detects every penetrating node
-    probe = c
-    probe%tol = 0; probe%nact = 0
+    ! a probe with no active constraint and zero tolerance detects every penetrating node
+    call new_probe(c, 0._dp, probe)
     call contact_update(probe, model, q, .true., added, .false.)
     free_pen = 0
     do k = 1, probe%nact
@@ -342,7 +344,7 @@ contains
   !> Signed distance of every impactor node to its target (the band's depth where farther,
   !> 0 for nodes that impact nothing), for output.
   subroutine contact_signed_distance(c, model, q, sd)
-    type(contact_t), intent(inout) :: c
+    type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     real(dp), intent(out) :: sd(:)
@@ -354,13 +356,23 @@ contains
       sd(model%body(b)%node_first:model%body(b)%node_last) = c%depth(c%pair(2, ip))
     end do
     ! every node inside the band, penetrating or not: a probe that takes any distance
-    probe = c
-    probe%nact = 0; probe%tol = -huge(1._dp)
+    call new_probe(c, -huge(1._dp), probe)
     call contact_update(probe, model, q, .true., added, .false.)
     do k = 1, probe%nact
       sd(probe%act(k)%node) = min(sd(probe%act(k)%node), probe%act(k)%sd)
     end do
   end subroutine contact_signed_distance
+
+  !> The geometry of c with no constraint and tolerance tol (for the diagnostics above).
+  subroutine new_probe(c, tol, probe)
+    type(contact_t), intent(in) :: c
+    real(dp), intent(in) :: tol
+    type(contact_t), intent(out) :: probe
+    probe%npairs = c%npairs; probe%pair = c%pair; probe%surf = c%surf; probe%depth = c%depth
+    allocate (probe%grid(c%npairs), probe%grid_ok(c%npairs), probe%act(16))
+    probe%grid_ok = .false.
+    probe%tol = tol
+  end subroutine new_probe
 
   !> Total normal contact force (sum of the compressive multipliers).
   pure real(dp) function contact_force_total(c)

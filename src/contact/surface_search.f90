@@ -79,13 +79,17 @@ contains
   end subroutine surface_init
 
   !> (Re)bin the sub-triangles at the current coordinates x(3, nnode). O(ntri + cells); the
-  !> arrays are reused when large enough, since this runs every Newton iteration.
-  subroutine grid_build(surf, x, grid)
+  !> arrays are reused when large enough, since this runs every Newton iteration. With
+  !> within(:, 1:2) (min and max corner) only the sub-triangles whose box meets it are binned:
+  !> nearest_subtriangle is then exact for the points whose rmax-ball lies inside that box
+  !> (the impactor's box grown by the band: the few target elements it can touch).
+  subroutine grid_build(surf, x, grid, within)
     type(surface_t), intent(in) :: surf
     real(dp), intent(in) :: x(:, :)
     type(grid_t), intent(inout) :: grid
+    real(dp), intent(in), optional :: within(3, 2)
     real(dp) :: ext(3), hcell, cap, ncell_r, nd(3), blo(3), bhi(3)
-    integer :: it, k, ncell, nentry, i0(3), i1(3), i, j, l, id, iter, pos
+    integer :: it, k, ncell, nentry, i0(3), i1(3), i, j, l, id, iter, pos, nkept
 
     grid%ntri = surf%ntri
     if (allocated(grid%stamp)) then
@@ -99,13 +103,16 @@ contains
     grid%lo = huge(1.0_dp)
     grid%hi = -huge(1.0_dp)
     hcell = 0.0_dp
+    nkept = 0
     do it = 1, surf%ntri
       call tri_box(surf, x, it, blo, bhi)
+      if (.not. kept()) cycle
+      nkept = nkept + 1
       grid%lo = min(grid%lo, blo)
       grid%hi = max(grid%hi, bhi)
       hcell = hcell + maxval(bhi - blo)
     end do
-    if (surf%ntri == 0) then
+    if (nkept == 0) then
       grid%lo = 0.0_dp
       grid%hi = 0.0_dp
     end if
@@ -114,9 +121,9 @@ contains
 
     ! Cell size = mean sub-triangle size (a sub-triangle then touches a few cells and a cell
     ! holds a few sub-triangles), enlarged if the cell count would exceed the cap.
-    if (surf%ntri > 0) hcell = hcell/real(surf%ntri, dp)
+    if (nkept > 0) hcell = hcell/real(nkept, dp)
     if (.not. (hcell > 0.0_dp)) hcell = max(maxval(ext), 1.0_dp)
-    cap = real(cells_per_tri*surf%ntri + cells_extra, dp)
+    cap = real(cells_per_tri*nkept + cells_extra, dp)
     do iter = 1, 100
       do k = 1, 3
         nd(k) = max(1.0_dp, real(ceiling(min(ext(k)/hcell, cap)), dp))
@@ -145,6 +152,7 @@ contains
     nentry = 0
     do it = 1, surf%ntri
       call tri_box(surf, x, it, blo, bhi)
+      if (.not. kept()) cycle
       call cell_range(grid, blo, bhi, i0, i1)
       do l = i0(3), i1(3)
         do j = i0(2), i1(2)
@@ -165,6 +173,7 @@ contains
     ! cell_start(id) serves as the insertion cursor, then everything is shifted back by one.
     do it = 1, surf%ntri
       call tri_box(surf, x, it, blo, bhi)
+      if (.not. kept()) cycle
       call cell_range(grid, blo, bhi, i0, i1)
       do l = i0(3), i1(3)
         do j = i0(2), i1(2)
@@ -183,6 +192,11 @@ contains
       grid%cell_start(id + 1) = grid%cell_start(id)
     end do
     grid%cell_start(1) = 1
+  contains
+    logical function kept()
+      kept = .true.
+      if (present(within)) kept = all(blo <= within(:, 2)) .and. all(bhi >= within(:, 1))
+    end function kept
   end subroutine grid_build
 
   !> Nearest sub-triangle to p among those at distance <= rmax (found = .false. if none), the

@@ -109,7 +109,8 @@ contains
     dir = trim(deck%output%dir)
     if (out_dir /= '') dir = trim(out_dir)
 
-    call assembly_setup(model, asm, err)
+    call setup_contact()
+    call assembly_setup(model, asm, err, split=split_bodies())
     if (failed('setup')) return
     if (deck%run%ordering == 'metis') solver%ordering = 1
     opts%tol = deck%run%newton_tol; opts%max_iter = deck%run%newton_max_iter
@@ -125,7 +126,6 @@ contains
         ' near (', deck%output%track(:, k)
       labels(k) = trim(labels(k))//')'
     end do
-    call setup_contact()
     call initial_state(deck, model, st)
     allocate (q0(model%ndof))
     call reference_state(model, q0)
@@ -181,7 +181,7 @@ contains
       if (failed('frame')) return
     end if
     if (is_root() .and. .not. quiet) print '(a,i0,a,i0,a,i0,a,i0,a)', 'casca: ', model%nbody, &
-      ' bodies, ', model%nelem, ' elements, ', asm%neq, ' unknowns, ', n_ranks, ' rank(s)'
+      ' bodies, ', model%nelem, ' elements, ', asm%neq_total, ' unknowns, ', n_ranks, ' rank(s)'
 
     total_newton = 0
     allocate (frozen(model%ndof), idle(model%nbody))
@@ -256,9 +256,15 @@ contains
       end do
       if (all(fz .eqv. frozen)) return
       frozen = fz
-      call assembly_setup(model, asm, err, frozen)
+      call assembly_setup(model, asm, err, frozen, split_bodies())
       call solver%new_pattern()
     end subroutine update_frozen
+
+    !> K is block diagonal by body unless the constraints are factorised with it ('saddle')
+    logical function split_bodies()
+      split_bodies = .true.
+      if (use_contact) split_bodies = contact%schur
+    end function split_bodies
 
     subroutine setup_contact()
       integer, allocatable :: pairs(:, :)

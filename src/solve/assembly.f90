@@ -2,6 +2,12 @@
 !> residual summed over the ranks, and the tangent into this rank's part of MUMPS's
 !> distributed input. The entry pattern is fixed at setup: each element writes its lower
 !> triangle of free-parameter pairs, in the same order at every call.
+!>
+!> Without constraints in the matrix K is block diagonal by body, so the bodies with unknowns
+!> are dealt to groups of ranks (as many as bodies, up to one rank each) and each group
+!> factorises and solves its own block: the solves, which dominate a long run, then need no
+!> communication at all. Two equal bodies on two ranks solve twice as fast, where one MUMPS
+!> instance over both ranks solves 1.2x as fast (docs/performance.md).
 module casca_assembly
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -14,8 +20,11 @@ module casca_assembly
   public :: assembly_t, assembly_setup, assemble
 
   type :: assembly_t
-    integer :: neq = 0
-    integer, allocatable :: eq(:)          !< (ndof) equation number, 0 if prescribed
+    integer :: neq = 0                     !< equations of this rank's group
+    integer :: neq_total = 0               !< equations of all groups
+    integer :: ngroups = 1                 !< groups of ranks, each with its bodies' block of K
+    logical :: host = .true.               !< first rank of its group (holds b and x)
+    integer, allocatable :: eq(:)          !< (ndof) equation in this rank's group, else 0
     integer, allocatable :: elems(:)       !< this rank's elements with unknowns
     integer, allocatable :: owned(:)       !< this rank's elements for accounting (all bodies)
     integer, allocatable :: estart(:)      !< (size(elems)+1) first entry of each element
@@ -26,46 +35,77 @@ module casca_assembly
 
 contains
 
-  !> Equation numbering of the free parameters (neither prescribed nor frozen), the partition
-  !> of the elements that have unknowns (METIS, computed on rank 0 and broadcast so that every
-  !> rank agrees; the others are dealt round for the accounting) and this rank's pattern.
-  subroutine assembly_setup(model, asm, err, frozen)
+  !> The free parameters (neither prescribed nor frozen), the groups (split: bodies may be
+  !> dealt to groups; false when constraints couple the bodies inside the matrix), this
+  !> group's equation numbering, and the elements: those of a group with several ranks are
+  !> partitioned by METIS (on rank 0, broadcast so that every rank agrees); the others are
+  !> dealt round for the accounting.
+  subroutine assembly_setup(model, asm, err, frozen, split)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(out) :: asm
     type(error_t), allocatable, intent(out) :: err
     logical, intent(in), optional :: frozen(:)   !< parameters advanced without solving
-    integer :: d(ndof_elem), e, k, i, j, n, ia, ib
-    integer, allocatable :: owner(:), active(:), part(:)
+    logical, intent(in), optional :: split
+    integer :: d(ndof_elem), e, k, i, j, n, ia, ib, b, g, mine
+    integer, allocatable :: owner(:), active(:), part(:), nfree(:), group(:)
+    logical, allocatable :: free(:)
+    real(dp), allocatable :: load(:)
+
+    free = .not. model%fixed
+    if (present(frozen)) free = free .and. .not. frozen
+    asm%neq_total = count(free)
+    allocate (nfree(model%nbody), group(model%nbody))
+    do b = 1, model%nbody
+      nfree(b) = count(free(7*model%body(b)%node_first - 6:7*model%body(b)%node_last))
+    end do
+    ! groups: the largest body first to the least loaded group (replicated, so alike everywhere)
+    asm%ngroups = 1
+    if (present(split)) then
+      if (split) asm%ngroups = max(1, min(n_ranks, count(nfree > 0)))
+    end if
+    allocate (load(asm%ngroups))
+    load = 0; group = 0
+    do k = 1, model%nbody
+      b = maxloc(nfree, dim=1, mask=nfree > 0)
+      if (b == 0) exit
+      g = minloc(load, dim=1) - 1
+      group(b) = g; load(g + 1) = load(g + 1) + nfree(b)
+      nfree(b) = -nfree(b) - 1   ! taken
+    end do
+    mine = mod(my_rank, asm%ngroups)
+    asm%host = my_rank < asm%ngroups
 
     allocate (asm%eq(model%ndof))
+    asm%eq = 0
     n = 0
     do i = 1, model%ndof
-      asm%eq(i) = 0
-      if (model%fixed(i)) cycle
-      if (present(frozen)) then
-        if (frozen(i)) cycle
-      end if
+      if (.not. free(i) .or. group(model%node_body((i - 1)/7 + 1)) /= mine) cycle
       n = n + 1; asm%eq(i) = n
     end do
     asm%neq = n
 
+    ! elements with unknowns: owner = a rank of their body's group
     allocate (owner(model%nelem))
-    active = pack([(e, e=1, model%nelem)], [(any(asm%eq(element_dofs(model, e)) > 0), e=1, model%nelem)])
+    active = pack([(e, e=1, model%nelem)], [(any(free(element_dofs(model, e))), e=1, model%nelem)])
     owner = [(mod(e, n_ranks), e=1, model%nelem)]
-    if (n_ranks > 1 .and. size(active) > 0) then
+    owner(active) = group(model%elem_body(active))
+    if (n_ranks > asm%ngroups .and. size(active) > 0) then
       allocate (part(size(active)))
+      part = 0
       if (is_root()) then
-        call partition_elements(model%conn(:, active), model%nnode, n_ranks, part, err)
+        do g = 0, asm%ngroups - 1
+          call partition_into(pack([(i, i=1, size(active))], owner(active) == g), &
+                              (n_ranks - 1 - g)/asm%ngroups + 1)
+          if (allocated(err)) exit
+        end do
         if (allocated(err)) part = -1   ! tell the other ranks, so that none waits forever
       end if
       call bcast_int(part)
-      if (part(1) < 0) then
+      if (any(part < 0)) then
         if (.not. allocated(err)) call fatal_error(err, 'element partition failed on rank 0')
         return
       end if
-      owner(active) = part
-    else if (size(active) > 0) then
-      owner(active) = 0
+      owner(active) = owner(active) + asm%ngroups*part
     end if
     asm%owned = pack([(e, e=1, model%nelem)], owner == my_rank)
     asm%elems = pack(active, owner(active) == my_rank)
@@ -98,6 +138,16 @@ contains
         end do
       end do
     end do
+  contains
+    !> part(idx) = 0..nparts-1: group g's active elements active(idx) over its nparts ranks
+    subroutine partition_into(idx, nparts)
+      integer, intent(in) :: idx(:), nparts
+      integer, allocatable :: p(:)
+      if (nparts <= 1 .or. size(idx) == 0) return
+      allocate (p(size(idx)))
+      call partition_elements(model%conn(:, active(idx)), model%nnode, nparts, p, err)
+      part(idx) = p
+    end subroutine partition_into
   end subroutine assembly_setup
 
   !> r = f_int(q) + cm M q - M qs  (qs, cm only in dynamics), summed over ranks, and

@@ -1,5 +1,6 @@
 !> Bodies that need no solving this step: unstressed and unloaded, in uniform translation
-!> (no spin), free of restraints, and with no contact candidate within reach of the step.
+!> (no spin), free of restraints, and with no impactor node within two steps' travel of the
+!> other body's bounding box.
 !> Newmark advances such a body exactly by q += dt v with zero acceleration, so casca does
 !> just that and leaves its parameters out of the equations (docs/method.md).
 module casca_free_flight
@@ -19,7 +20,7 @@ contains
     logical, intent(out) :: idle(:)
     type(contact_t), intent(in), optional :: contact
     real(dp) :: lo(3, model%nbody), hi(3, model%nbody), speed(model%nbody), reach
-    real(dp) :: shift(3), v(3), tol
+    real(dp) :: shift(3), v(3), tol, x(3)
     integer :: b, n, k, i, j, f, l
     tol = 1e-12_dp*model%length
     do b = 1, model%nbody
@@ -29,10 +30,11 @@ contains
         idle(b) = .not. any(model%fixed(f:l)) .and. all(fext(f:l) == 0) .and. all(qdd(f:l) == 0)
         shift = q(dof(bd%node_first, 1):dof(bd%node_first, 3)) - model%x0(:, bd%node_first)
         v = qd(dof(bd%node_first, 1):dof(bd%node_first, 3))
-        speed(b) = norm2(v)
+        speed(b) = 0
         do n = bd%node_first, bd%node_last
           lo(:, b) = min(lo(:, b), q(dof(n, 1):dof(n, 3)))
           hi(:, b) = max(hi(:, b), q(dof(n, 1):dof(n, 3)))
+          speed(b) = max(speed(b), norm2(qd(dof(n, 1):dof(n, 3))))
           if (.not. idle(b)) cycle
           idle(b) = all(abs(q(dof(n, 1):dof(n, 3)) - model%x0(:, n) - shift) <= tol) .and. &
                     all(abs(q(dof(n, 4):dof(n, 6)) - model%v0(:, n)) <= 1e-12_dp) .and. &
@@ -46,12 +48,17 @@ contains
       i = model%node_body(contact%act(k)%node)
       idle(i) = .false.; idle(contact%pair(2, contact%act(k)%pair)) = .false.
     end do
-    do k = 1, contact%npairs  ! boxes that could meet within two steps
+    do k = 1, contact%npairs  ! an impactor node that could reach the target within two steps
       i = contact%pair(1, k); j = contact%pair(2, k)
-      reach = contact%depth(j) + 2*dt*(speed(i) + speed(j))
-      if (all(lo(:, i) <= hi(:, j) + reach) .and. all(hi(:, i) >= lo(:, j) - reach)) then
-        idle(i) = .false.; idle(j) = .false.
-      end if
+      if (.not. (idle(i) .or. idle(j))) cycle
+      reach = 2*dt*(speed(i) + speed(j)) + contact%tol
+      do n = model%body(i)%node_first, model%body(i)%node_last
+        x = q(dof(n, 1):dof(n, 3))
+        if (all(x <= hi(:, j) + reach) .and. all(x >= lo(:, j) - reach)) then
+          idle(i) = .false.; idle(j) = .false.
+          exit
+        end if
+      end do
     end do
   end subroutine idle_bodies
 

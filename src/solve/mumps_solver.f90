@@ -1,11 +1,12 @@
-!> Sparse symmetric (indefinite) solver: MUMPS with the matrix distributed over the ranks as
-!> assembled entries (ICNTL(18) = 3), right-hand side and solution centralised on rank 0.
-!> The analysis is kept while the sparsity pattern does not change; each Newton iteration only
-!> refactorises (JOB = 2) and solves (JOB = 3).
+!> Sparse symmetric (indefinite) solver: MUMPS on one group of ranks (casca_mpi's
+!> group_handle; all ranks when there is one group), with the matrix distributed over the
+!> group as assembled entries (ICNTL(18) = 3) and right-hand side and solution on the group's
+!> host (its first rank). The analysis is kept while the sparsity pattern does not change;
+!> each Newton iteration only refactorises (JOB = 2) and solves (JOB = 3).
 module casca_mumps_solver
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_mpi, only: comm_handle, is_root, bcast_real
+  use casca_mpi, only: group_handle
   implicit none
   private
   public :: sparse_solver_t
@@ -22,6 +23,7 @@ module casca_mumps_solver
   type :: sparse_solver_t
     type(dmumps_struc), private :: id
     logical :: started = .false.
+    integer :: ngroups = 1          !< the ranks are dealt into this many groups (one instance each)
     logical :: analysed = .false.
     logical :: factored = .false.   !< holds factors of the analysed pattern
     integer :: factorisations = 0   !< counter: tells whether factors changed
@@ -35,6 +37,7 @@ module casca_mumps_solver
     procedure :: solve => solver_solve
     procedure :: solve_many => solver_solve_many
     procedure :: negative_pivots => solver_negative_pivots
+    procedure :: host => solver_host
     procedure :: drop_factors => solver_drop_factors
     procedure :: new_pattern => solver_new_pattern
     procedure :: finish => solver_finish
@@ -42,10 +45,14 @@ module casca_mumps_solver
 
 contains
 
-  subroutine solver_init(self)
+  !> Start MUMPS on this rank's group of ngroups (collective over all ranks when it changes).
+  subroutine solver_init(self, ngroups)
     class(sparse_solver_t), intent(inout) :: self
-    if (self%started) return
-    self%id%comm = comm_handle()
+    integer, intent(in) :: ngroups
+    if (self%started .and. self%ngroups == ngroups) return
+    call self%finish()
+    self%ngroups = ngroups
+    self%id%comm = group_handle(ngroups)
     self%id%sym = 2    ! symmetric, possibly indefinite (saddle points of contact)
     self%id%par = 1    ! the host works too
     self%id%job = -1
@@ -60,13 +67,19 @@ contains
     self%started = .true.
   end subroutine solver_init
 
-  !> Symbolic analysis of the pattern irn(k) >= jcn(k) (this rank's entries; duplicates sum).
-  !> perm: pivot order (rank 0), used when ordering = 1.
-  subroutine solver_analyse(self, n, irn, jcn, perm, err)
+  !> Symbolic analysis of the pattern irn(k) >= jcn(k) (this rank's entries; duplicates sum)
+  !> of this rank's group (ngroups groups; 1 if absent). perm: pivot order (host), used when
+  !> ordering = 1.
+  subroutine solver_analyse(self, n, irn, jcn, perm, err, ngroups)
     class(sparse_solver_t), intent(inout) :: self
     integer, intent(in) :: n, irn(:), jcn(:), perm(:)
     type(error_t), allocatable, intent(out) :: err
-    call self%init()
+    integer, intent(in), optional :: ngroups
+    if (present(ngroups)) then
+      call self%init(ngroups)
+    else
+      call self%init(1)
+    end if
     if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
     self%id%n = n
     self%id%nnz_loc = size(irn, kind=8)
@@ -76,7 +89,7 @@ contains
     self%id%a_loc = 0
     if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
     self%id%icntl(7) = self%ordering
-    if (self%ordering == 1 .and. is_root()) then
+    if (self%ordering == 1 .and. self%host()) then
       allocate (self%id%perm_in(n))
       self%id%perm_in = perm
     end if
@@ -106,13 +119,13 @@ contains
     self%factorisations = self%factorisations + 1
   end subroutine solver_factorise
 
-  !> x = K^-1 b; b needed on rank 0 only, x returned on every rank.
+  !> x = K^-1 b; b needed on the host only, x returned on the host (zero elsewhere).
   subroutine solver_solve(self, b, x, err)
     class(sparse_solver_t), intent(inout) :: self
     real(dp), intent(in) :: b(:)
     real(dp), intent(out) :: x(:)
     type(error_t), allocatable, intent(out) :: err
-    if (is_root()) then
+    if (self%host()) then
       if (associated(self%id%rhs)) then
         if (size(self%id%rhs) /= size(b)) deallocate (self%id%rhs)
       end if
@@ -123,12 +136,12 @@ contains
     call dmumps(self%id)
     call check(self, 'solution', err)
     if (allocated(err)) return
-    if (is_root()) x = self%id%rhs
-    call bcast_real(x)
+    x = 0
+    if (self%host()) x = self%id%rhs
   end subroutine solver_solve
 
-  !> X = K^-1 B for several right-hand sides at once (B, X: (n, m) on rank 0; X is
-  !> returned on rank 0 only).
+  !> X = K^-1 B for several right-hand sides at once (B, X: (n, m) on the host; X is
+  !> returned on the host only).
   subroutine solver_solve_many(self, b, x, err)
     class(sparse_solver_t), intent(inout) :: self
     real(dp), intent(in) :: b(:, :)
@@ -136,7 +149,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     integer :: n, m
     n = size(b, 1); m = size(b, 2)
-    if (is_root()) then
+    if (self%host()) then
       if (associated(self%id%rhs)) deallocate (self%id%rhs)
       allocate (self%id%rhs(n*m))
       self%id%rhs = reshape(b, [n*m])
@@ -147,7 +160,7 @@ contains
     self%id%nrhs = 1
     call check(self, 'solution', err)
     if (allocated(err)) return
-    if (is_root()) x = reshape(self%id%rhs, [n, m])
+    if (self%host()) x = reshape(self%id%rhs, [n, m])
   end subroutine solver_solve_many
 
   !> Negative pivots of the last factorisation (the inertia of a saddle-point matrix).
@@ -155,6 +168,12 @@ contains
     class(sparse_solver_t), intent(in) :: self
     solver_negative_pivots = self%id%infog(12)
   end function solver_negative_pivots
+
+  !> This rank is its group's host (MUMPS's rank 0 in the group): it holds b and x.
+  logical function solver_host(self)
+    class(sparse_solver_t), intent(in) :: self
+    solver_host = self%id%myid == 0
+  end function solver_host
 
   !> The next solve refactorises: used after a checkpoint so that a run restarted from it
   !> takes exactly the path of the run that wrote it.

@@ -7,7 +7,7 @@ module casca_newmark
   use casca_assembly, only: assembly_t
   use casca_mumps_solver, only: sparse_solver_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t, contact_persistency
+  use casca_contact, only: contact_t, constraint_t, contact_persistency
   implicit none
   private
   public :: state_t, newmark_t, newmark_step, static_solve
@@ -40,7 +40,7 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp), allocatable :: qs(:), rs(:), q(:)
     real(dp) :: b, dt, g
-    type(contact_t), allocatable :: saved
+    type(constraint_t), allocatable :: saved(:)   ! the active set, kept for a failed step
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
     qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*st%qdd
@@ -49,7 +49,7 @@ contains
     q = st%q + dt*st%qd + dt*dt*(0.5_dp - b)*st%qdd
     where (model%fixed) q = st%q
     if (present(contact)) then
-      saved = contact
+      saved = contact%act(1:contact%nact)
       call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
     else
       call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs)
@@ -57,7 +57,10 @@ contains
     if (.not. allocated(err) .and. .not. rep%converged) &
       call fatal_error(err, 'Newton did not converge')
     if (allocated(err)) then
-      if (present(contact)) contact = saved
+      if (present(contact)) then
+        contact%nact = size(saved)
+        contact%act(1:size(saved)) = saved
+      end if
       return
     end if
     st%q = q

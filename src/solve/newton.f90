@@ -17,7 +17,7 @@ module casca_newton
   use casca_assembly, only: assembly_t, assemble
   use casca_mumps_solver, only: sparse_solver_t
   use casca_contact, only: contact_t, contact_update, contact_release, contact_rows
-  use casca_mpi, only: is_root, bcast_real, bcast_int
+  use casca_mpi, only: is_root, sum_all, share_error
   use casca_metis, only: nested_dissection
   use casca_lapack, only: dsyev, dgetrf, dgetrs
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
@@ -58,14 +58,14 @@ contains
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: cm, qs(:)
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:), cval_f(:)
+    real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:), cval_f(:), dq(:)
     integer, allocatable :: cirn(:), cjcn(:), cirn_f(:), cjcn_f(:)
     integer :: it, i, nc, added, released, k, schur_positive
     real(dp) :: nrm
     logical :: settled, fresh, schur, renew_z
 
     allocate (r(model%ndof), cirn_f(0), cjcn_f(0), cval_f(0))
-    if (asm%neq == 0) then   ! every body is frozen this step: nothing to solve
+    if (asm%neq_total == 0) then   ! every body is frozen this step: nothing to solve
       rep%converged = .true.
       return
     end if
@@ -93,6 +93,7 @@ contains
       call timer_start(t_analysis)
       call analyse_if_needed()
       call timer_stop(t_analysis)
+      call share_error(err)
       if (allocated(err)) return
 
       ! a new matrix unless the kept one still contracts the increment fourfold (decided from
@@ -116,18 +117,20 @@ contains
       call timer_stop(t_assembly)
       if (fresh) then
         call timer_start(t_factor)
-        if (is_root()) then
+        if (asm%host) then
           call solver%factorise([asm%a, cval_f], err)
         else
           call solver%factorise(asm%a, err)
         end if
         call timer_stop(t_factor)
+        call share_error(err)   ! the groups factorise apart: all go on, or none
         if (allocated(err)) return
         rep%factorisations = rep%factorisations + 1
       end if
 
       allocate (b(asm%neq + nc), x(asm%neq + nc))
-      if (is_root()) then
+      b = 0
+      if (asm%host) then
         do i = 1, model%ndof
           if (asm%eq(i) > 0) b(asm%eq(i)) = -r(i)
         end do
@@ -142,15 +145,27 @@ contains
         call schur_solve()
       else
         call solver%solve(b, x, err)
+        call share_error(err)
       end if
+      if (allocated(err)) then
+        call timer_stop(t_solve); return
+      end if
+      ! the whole increment on every rank: each host gives its group's part, rank 0 the
+      ! multipliers' (every rank has them with 'schur'; rank 0 is the only host with 'saddle')
+      allocate (dq(model%ndof + nc))
+      dq = 0
+      if (asm%host) then
+        do i = 1, model%ndof
+          if (asm%eq(i) > 0) dq(i) = x(asm%eq(i))
+        end do
+      end if
+      if (is_root()) dq(model%ndof + 1:) = x(asm%neq + 1:)
+      call sum_all(dq)
       call timer_stop(t_solve)
-      if (allocated(err)) return
-      do i = 1, model%ndof
-        if (asm%eq(i) > 0) q(i) = q(i) + x(asm%eq(i))
-      end do
-      if (nc > 0) contact%act(1:nc)%lambda = contact%act(1:nc)%lambda + x(asm%neq + 1:)
-      nrm = maxval(abs(x(1:asm%neq)))/model%length
-      deallocate (b, x, cirn, cjcn, cval, gap)
+      q = q + dq(1:model%ndof)
+      if (nc > 0) contact%act(1:nc)%lambda = contact%act(1:nc)%lambda + dq(model%ndof + 1:)
+      nrm = maxval(abs(dq(1:model%ndof)))/model%length
+      deallocate (b, x, dq, cirn, cjcn, cval, gap)
       rep%iters = it
       rep%incr(it) = nrm
       if (.not. (nrm <= 1e6_dp)) then   ! also catches NaN
@@ -171,7 +186,9 @@ contains
       end if
       if (settled) then
         rep%converged = .true.
-        rep%neg_pivots = solver%negative_pivots()   ! of the factors in use
+        rep%neg_pivots = 0   ! of the factors in use, summed over the groups
+        if (asm%host) rep%neg_pivots = solver%negative_pivots()
+        call sum_all(rep%neg_pivots)
         if (schur .and. nc > 0) rep%neg_pivots = rep%neg_pivots + schur_positive
         return
       end if
@@ -179,19 +196,23 @@ contains
   contains
     !> The saddle-point system through the Schur complement of K: Z = K^-1 C^T, S = C Z,
     !> y = K^-1 b, S dlambda = C y + g, dq = y - Z dlambda. Z and S are kept (with the rows
-    !> they were made from) while the rows' pattern and K's factors stay and contraction is
-    !> good, so most iterations cost one solve. The inertia of the saddle-point matrix is that
-    !> of K plus the positive eigenvalues of S.
+    !> they were made from) while the constraints (node, element), K's factors and good
+    !> contraction stay, so most iterations cost one solve. Each group's host holds its block
+    !> of Z and y; S and C y are summed over the groups and S is factorised on every rank, so
+    !> dlambda is replicated. The inertia of the saddle-point matrix is that of K plus the
+    !> positive eigenvalues of S.
     subroutine schur_solve()
       real(dp), allocatable :: bb(:, :), yy(:, :), sc(:, :), rhs(:), eig(:), work(:), y(:)
       integer :: e, kk, info, lwork
       logical :: valid
       valid = .false.
-      if (allocated(contact%z_irn)) then
+      if (allocated(contact%z_node)) then   ! replicated figures: every group decides alike
         valid = .not. renew_z .and. contact%z_factor == solver%factorisations .and. &
-                size(contact%z_irn) == size(cirn)
-        if (valid) valid = all(contact%z_irn == cirn) .and. all(contact%z_jcn == cjcn)
+                size(contact%z_node) == nc
+        if (valid) valid = all(contact%z_node == contact%act(1:nc)%node) .and. &
+                           all(contact%z_elem == contact%act(1:nc)%elem)
       end if
+      allocate (y(asm%neq))
       if (.not. valid) then   ! Z and S from the current rows: nc + 1 right-hand sides
         allocate (bb(asm%neq, nc + 1), yy(asm%neq, nc + 1))
         bb = 0
@@ -200,54 +221,58 @@ contains
           if (cirn(e) /= cjcn(e)) bb(cjcn(e), 1 + cirn(e) - asm%neq) = cval(e)
         end do
         call solver%solve_many(bb, yy, err)
+        call share_error(err)
         if (allocated(err)) return
         contact%z_irn = cirn; contact%z_jcn = cjcn; contact%z_val = cval
+        contact%z_node = contact%act(1:nc)%node; contact%z_elem = contact%act(1:nc)%elem
         contact%z_factor = solver%factorisations
-        if (is_root()) then
+        if (allocated(contact%s)) deallocate (contact%s)
+        allocate (contact%s(nc, nc))
+        contact%s = 0
+        if (asm%host) then
           contact%z = yy(:, 2:)
           y = yy(:, 1)
-          if (allocated(contact%s)) deallocate (contact%s)
-          allocate (contact%s(nc, nc))
-          contact%s = 0
           do e = 1, size(cirn)
             if (cirn(e) == cjcn(e)) cycle
             kk = cirn(e) - asm%neq
             contact%s(kk, :) = contact%s(kk, :) + cval(e)*contact%z(cjcn(e), :)
           end do
-          contact%s = 0.5_dp*(contact%s + transpose(contact%s))
-          sc = contact%s
-          lwork = max(1, 3*nc)
-          allocate (eig(nc), work(lwork))
-          call dsyev('N', 'U', nc, sc, nc, eig, work, lwork, info)
-          contact%z_positive = count(eig > 0)
-          if (allocated(contact%z_ipiv)) deallocate (contact%z_ipiv)
-          allocate (contact%z_ipiv(nc))
-          call dgetrf(nc, nc, contact%s, nc, contact%z_ipiv, info)
-          if (info /= 0) contact%z_ipiv = -1   ! dependent constraints: no correction
         end if
+        call sum_all(contact%s)
+        contact%s = 0.5_dp*(contact%s + transpose(contact%s))
+        sc = contact%s
+        lwork = max(1, 3*nc)
+        allocate (eig(nc), work(lwork))
+        call dsyev('N', 'U', nc, sc, nc, eig, work, lwork, info)
+        contact%z_positive = count(eig > 0)
+        if (allocated(contact%z_ipiv)) deallocate (contact%z_ipiv)
+        allocate (contact%z_ipiv(nc))
+        call dgetrf(nc, nc, contact%s, nc, contact%z_ipiv, info)
+        if (info /= 0) contact%z_ipiv = -1   ! dependent constraints: no correction
       else                    ! the kept Z and S: one right-hand side
-        allocate (y(asm%neq))
         call solver%solve(b(1:asm%neq), y, err)
+        call share_error(err)
         if (allocated(err)) return
       end if
-      if (is_root()) then
-        rhs = gap   ! C_kept y + g: the matrix is [K, C_kept^T; C_kept, 0] throughout
+      allocate (rhs(nc))
+      rhs = 0   ! C_kept y + g: the matrix is [K, C_kept^T; C_kept, 0] throughout
+      if (asm%host) then
         do e = 1, size(contact%z_irn)
           if (contact%z_irn(e) == contact%z_jcn(e)) cycle
           kk = contact%z_irn(e) - asm%neq
           rhs(kk) = rhs(kk) + contact%z_val(e)*y(contact%z_jcn(e))
         end do
-        if (contact%z_ipiv(1) > 0) then
-          call dgetrs('N', nc, 1, contact%s, nc, contact%z_ipiv, rhs, nc, info)
-        else
-          rhs = 0
-        end if
-        x(1:asm%neq) = y - matmul(contact%z, rhs)
-        x(asm%neq + 1:) = rhs
       end if
-      call bcast_real(x)
+      call sum_all(rhs)
+      rhs = rhs + gap
+      if (contact%z_ipiv(1) > 0) then
+        call dgetrs('N', nc, 1, contact%s, nc, contact%z_ipiv, rhs, nc, info)
+      else
+        rhs = 0
+      end if
+      if (asm%host) x(1:asm%neq) = y - matmul(contact%z, rhs)
+      x(asm%neq + 1:) = rhs
       schur_positive = contact%z_positive
-      call bcast_int(schur_positive)
     end subroutine schur_solve
 
 
@@ -261,16 +286,17 @@ contains
       end if
       allocate (perm(0))
       nf = count(cirn_f == cjcn_f)   ! multipliers inside the factorised matrix
-      if (solver%ordering == 1 .and. is_root()) then
+      if (solver%ordering == 1 .and. asm%host) then
         deallocate (perm); allocate (perm(asm%neq + nf))
         call nested_dissection(model%conn, model%nnode, asm%eq, asm%neq, perm, err)
         if (allocated(err)) return
         perm(asm%neq + 1:) = [(asm%neq + i, i=1, nf)]   ! multipliers last
       end if
-      if (is_root()) then
-        call solver%analyse(asm%neq + nf, [asm%irn, cirn_f], [asm%jcn, cjcn_f], perm, err)
+      if (asm%host) then
+        call solver%analyse(asm%neq + nf, [asm%irn, cirn_f], [asm%jcn, cjcn_f], perm, err, &
+                            asm%ngroups)
       else
-        call solver%analyse(asm%neq + nf, asm%irn, asm%jcn, perm, err)
+        call solver%analyse(asm%neq + nf, asm%irn, asm%jcn, perm, err, asm%ngroups)
       end if
       rep%analyses = rep%analyses + 1
       if (present(contact)) then
