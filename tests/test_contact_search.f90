@@ -22,6 +22,7 @@ program test_contact_search
   call test_brute_force()
   call test_random_cloud()
   call test_rings()
+  call test_restricted_grid()
   call test_parent_xi()
   call timing()
 
@@ -275,6 +276,35 @@ contains
       end if
     end do
   end subroutine compare_searches
+
+  !> A grid built only over the sub-triangles that meet a box (the impactor's, grown by the
+  !> band) answers exactly as the all-pairs scan of the whole surface for every point whose
+  !> rmax-ball lies in that box.
+  subroutine test_restricted_grid()
+    type(mesh_t) :: mesh
+    type(error_t), allocatable :: err
+    type(surface_t) :: surf
+    type(grid_t) :: grid
+    real(dp), parameter :: rmax = 0.05_dp
+    real(dp) :: within(3, 2), pts(3, 5000), r(3)
+    integer :: ip, nbad, nfound
+    call mesh_sphere(1.0_dp, 6, mesh, err)
+    if (allocated(err)) then
+      call check('restricted grid: sphere mesh', .false., 0.0_dp); return
+    end if
+    call surface_init(mesh%conn, [(ip, ip=1, mesh%nelem)], surf)
+    within(:, 1) = [0.6_dp, -0.5_dp, -0.5_dp]; within(:, 2) = [1.2_dp, 0.5_dp, 0.5_dp]
+    call grid_build(surf, mesh%x, grid, within)
+    do ip = 1, size(pts, 2)   ! points in the box shrunk by rmax, half of them near the surface
+      pts(:, ip) = within(:, 1) + rmax + (within(:, 2) - within(:, 1) - 2*rmax)*rand3()
+      r = rand3()
+      if (mod(ip, 2) == 0) pts(1, ip) = sqrt(max(0.0_dp, 1 - pts(2, ip)**2 - pts(3, ip)**2)) &
+                                        + 0.04_dp*(2*r(1) - 1)
+    end do
+    call compare_searches(surf, grid, mesh%x, pts, rmax, nbad, nfound)
+    call check('restricted grid == all pairs within rmax, points in the box (mismatches)', &
+               nbad == 0 .and. nfound > 1000, real(nbad, dp))
+  end subroutine test_restricted_grid
 
   !> 300 cubic elements with random node coordinates: clusters of small elements, a few
   !> elements spanning the cloud, and a few degenerate ones (coincident / collinear nodes).

@@ -3,9 +3,11 @@
 usage: test_scenes.py CASCA EXAMPLES_DIR WORK_DIR [--quick]
   strip_wall: 1D bar theory (contact 2L/c, force rho c v0 b h, rebound v0)
   two_rings:  momentum conservation, no penetration, touch then separate, inertia,
-              same history on 1 and 2 ranks
-  three_rings, three_spheres: run to completion (spheres shortened to 0.3 ms here: they first
-              touch at 1 ms, 0.01 m apart at 10 m/s; the README's command runs the whole scene)
+              same history on 1 and 2 ranks (each ring on its own rank)
+  three_rings: runs to completion; same history on 1 and 2 ranks (two rings on one rank)
+  three_spheres: shortened to 1.2 ms here (the README's command runs the whole scene): the
+              spheres are 0.01 m apart at 10 m/s, so they first touch at t = 1 ms, and until
+              they are within reach no body is solved; sphere 3 stays exactly where it was
 """
 import os
 import sys
@@ -60,20 +62,27 @@ print("two_rings: contact from %.2f ms to %.2f ms (thesis: about 25 ms)"
 ck.record("two_rings: inertia of every saddle-point factorisation = active constraints",
           np.all(h["neg_pivots"][1:] == h["contacts"][1:]))
 
-# --- two rings on 1 and 2 ranks: same tracked-node history (first 8 ms: contact included)
-short = deck_variant(os.path.join(examples, "two_rings.nml"), os.path.join(work, "rings8.nml"),
-                     t_end="0.008")
-hist = []
-for n in (1, 2):
-    out = os.path.join(work, "rings8_np%d" % n)
-    p = run([casca, "run", short, "--out", out, "-q"], np_ranks=n)
-    ck.record("two_rings 8 ms on %d rank(s) runs" % n, p.returncode == 0, p.stderr[-300:])
-    hist.append(history(out))
-cols = [k for k in hist[0] if k.startswith("p") and "_" in k]
-diff = max(np.max(np.abs(hist[0][k] - hist[1][k])) for k in cols)
-scale = max(np.max(np.abs(hist[0][k])) for k in cols)
-ck.le("two_rings: tracked nodes on 1 and 2 ranks (max diff / max value)", diff / scale, 1e-8)
-ck.record("two_rings: contact reached within the 8 ms", hist[0]["contacts"].max() > 0)
+# --- 1 and 2 ranks: same tracked-node history (first 8 ms: contact included). On 2 ranks the
+# bodies are dealt to the ranks (two rings: one each; three rings: two and one)
+def same_on_1_and_2_ranks(name):
+    short = deck_variant(os.path.join(examples, name + ".nml"), os.path.join(work, name + "8.nml"),
+                         t_end="0.008")
+    hist = []
+    for n in (1, 2):
+        out = os.path.join(work, "%s8_np%d" % (name, n))
+        p = run([casca, "run", short, "--out", out, "-q"], np_ranks=n)
+        ck.record("%s 8 ms on %d rank(s) runs" % (name, n), p.returncode == 0, p.stderr[-300:])
+        hist.append(history(out))
+    cols = [k for k in hist[0] if k.startswith("p") and "_" in k]
+    diff = max(np.max(np.abs(hist[0][k] - hist[1][k])) for k in cols)
+    scale = max(np.max(np.abs(hist[0][k])) for k in cols)
+    ck.le("%s: tracked nodes on 1 and 2 ranks (max diff / max value)" % name, diff / scale, 1e-8)
+    ck.record("%s: contact reached within the 8 ms" % name, hist[0]["contacts"].max() > 0)
+    return short, hist
+
+
+short, hist = same_on_1_and_2_ranks("two_rings")
+same_on_1_and_2_ranks("three_rings")
 
 # --- the saddle-point matrix itself factored by MUMPS (symmetric indefinite), on 2 ranks:
 # its inertia (negative pivots = active constraints) and the same motion as the Schur path
@@ -103,16 +112,26 @@ if p.returncode == 0:
               h["contacts"].max() >= 2)
     fixed_y = h["p4_y"]  # ring 3's target node: y restrained at its lowest point only
     print("three_rings: tracked y of ring 3's target node from %.5f to %.5f" % (fixed_y[0], fixed_y[-1]))
+dt_s = 3.0e-6
 spheres = deck_variant(os.path.join(examples, "three_spheres.nml"),
-                       os.path.join(work, "spheres.nml"), t_end="3.0e-4")
+                       os.path.join(work, "spheres.nml"), t_end="1.2e-3")
 out = os.path.join(work, "three_spheres")
 p = run([casca, "run", spheres, "--out", out, "-q"], np_ranks=2)
-ck.record("three_spheres (0.3 ms, 2 ranks) runs to completion (exit 0)", p.returncode == 0,
+ck.record("three_spheres (1.2 ms, 2 ranks) runs to completion (exit 0)", p.returncode == 0,
           p.stderr[-300:])
 if p.returncode == 0:
     h = history(out)
-    ck.close("three_spheres: reaches t_end", h["t"][-1], 3e-4, 1e-9)
+    ck.close("three_spheres: reaches t_end", h["t"][-1], 1.2e-3, 1e-9)
     p0 = np.array([h["px"][0], h["py"][0], h["pz"][0]])
     dp = np.max(np.linalg.norm(np.stack([h["px"], h["py"], h["pz"]]).T - p0, axis=1))
     ck.le("three_spheres: linear momentum (max |p - p0| / |p0|)", dp / np.linalg.norm(p0), 1e-8)
+    first = h["t"][np.nonzero(h["contacts"] > 0)[0][0]]
+    ck.le("three_spheres: first contact at gap / speed = 1 ms, within a step [s]",
+          abs(first - 1.0e-3), dt_s)
+    # within reach: 2 steps of travel (2 dt v = 6e-5 m) before the 0.01 m gap closes
+    ck.record("three_spheres: no Newton iteration before the spheres are within reach (t < 0.99 ms)",
+              np.all(h["newton"][(h["t"] > 0) & (h["t"] < 0.99e-3)] == 0))
+    ck.le("three_spheres: sphere 3 does not move before the wave arrives [m]",
+          np.max(np.abs(h["p4_x"] - 3.02)), 1e-12)
+    ck.le("three_spheres: deepest penetration [m]", h["penetration"].max(), 1e-6)
 ck.finish()
