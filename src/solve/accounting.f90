@@ -3,7 +3,7 @@
 module casca_accounting
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_assembly, only: assembly_t, assemble
+  use casca_assembly, only: assembly_t, strain_energy
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
   use casca_vectors, only: cross
@@ -21,16 +21,14 @@ contains
   !> fext: the dead load; q0: the state where its work is zero.
   subroutine account(model, asm, st, fext, q0, bal)
     type(model_t), intent(in) :: model
-    type(assembly_t), intent(inout) :: asm
+    type(assembly_t), intent(in) :: asm
     type(state_t), intent(in) :: st
     real(dp), intent(in) :: fext(:), q0(:)
     type(balance_t), intent(out) :: bal
     real(dp) :: x(3, 20), v(3, 20), mv(3, 20), s(7)
-    real(dp), allocatable :: r(:)
     integer :: i, e, p
 
-    allocate (r(model%ndof))
-    call assemble(model, asm, st%q, .false., r, bal%strain)
+    bal%strain = strain_energy(model, asm, st%q)
     s = 0
     do i = 1, size(asm%owned)   ! every body: frozen ones move too
       e = asm%owned(i)

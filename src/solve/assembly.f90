@@ -17,7 +17,7 @@ module casca_assembly
   use casca_metis, only: partition_elements
   implicit none
   private
-  public :: assembly_t, assembly_setup, assemble
+  public :: assembly_t, assembly_setup, assemble, strain_energy
 
   type :: assembly_t
     integer :: neq = 0                     !< equations of this rank's group
@@ -27,6 +27,9 @@ module casca_assembly
     integer, allocatable :: eq(:)          !< (ndof) equation in this rank's group, else 0
     integer, allocatable :: elems(:)       !< this rank's elements with unknowns
     integer, allocatable :: owned(:)       !< this rank's elements for accounting (all bodies)
+    integer, allocatable :: dealt(:)       !< elements with unknowns dealt round all ranks:
+                                           !< force-only assembly and strain energy, balanced
+                                           !< whatever the groups
     integer, allocatable :: estart(:)      !< (size(elems)+1) first entry of each element
     integer, allocatable :: pos(:)         !< element-matrix linear index of each entry
     integer, allocatable :: irn(:), jcn(:) !< equations of each entry (irn >= jcn)
@@ -51,6 +54,7 @@ contains
     logical, allocatable :: free(:)
     real(dp), allocatable :: load(:)
 
+    allocate (free(model%ndof))
     free = .not. model%fixed
     if (present(frozen)) free = free .and. .not. frozen
     asm%neq_total = count(free)
@@ -108,6 +112,7 @@ contains
       owner(active) = owner(active) + asm%ngroups*part
     end if
     asm%owned = pack([(e, e=1, model%nelem)], owner == my_rank)
+    asm%dealt = pack(active, [(mod(i, n_ranks) == my_rank, i=1, size(active))])
     asm%elems = pack(active, owner(active) == my_rank)
     allocate (asm%estart(size(asm%elems) + 1))
     ! count, then fill
@@ -151,7 +156,9 @@ contains
   end subroutine assembly_setup
 
   !> r = f_int(q) + cm M q - M qs  (qs, cm only in dynamics), summed over ranks, and
-  !> (want_k) asm%a = H + cm M. energy: strain energy of q (sum over ranks).
+  !> (want_k) asm%a = H + cm M. energy: strain energy of q (sum over ranks). The tangent goes
+  !> to the group's MUMPS instance, so with want_k the elements are this rank's of its group;
+  !> without, any split will do and the elements dealt round keep the ranks evenly loaded.
   subroutine assemble(model, asm, q, want_k, r, energy, cm, qs)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
@@ -165,8 +172,12 @@ contains
 
     dynamic = present(cm)
     r = 0; energy = 0
-    do i = 1, size(asm%elems)
-      e = asm%elems(i)
+    do i = 1, merge(size(asm%elems), size(asm%dealt), want_k)
+      if (want_k) then
+        e = asm%elems(i)
+      else
+        e = asm%dealt(i)
+      end if
       d = element_dofs(model, e)
       qe = reshape(q(d), [7, 10])
       b = model%elem_body(e)
@@ -206,6 +217,26 @@ contains
       end do
     end function qs_part
   end subroutine assemble
+
+  !> Strain energy of q (sum over ranks), balanced over the ranks whatever the groups.
+  real(dp) function strain_energy(model, asm, q) result(energy)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(in) :: asm
+    real(dp), intent(in) :: q(:)
+    real(dp) :: fe(ndof_elem), ke(ndof_elem, ndof_elem), ue   ! ke: not touched
+    integer :: i, e, b
+    energy = 0
+    do i = 1, size(asm%dealt)
+      e = asm%dealt(i)
+      b = model%elem_body(e)
+      call shell_energy_force(model%rule, model%body(b)%thickness, model%body(b)%lam, &
+                              model%body(b)%mu, model%binv(:, :, :, e), model%wdet(:, e), &
+                              reshape(q(element_dofs(model, e)), [7, 10]), .false., ue, fe, ke, &
+                              want_f=.false.)
+      energy = energy + ue
+    end do
+    call sum_all(energy)
+  end function strain_energy
 
   !> ke += m (x) I3 on the (Y, G) parameters
   pure subroutine add_mass(ke, m)
