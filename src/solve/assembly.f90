@@ -49,7 +49,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     logical, intent(in), optional :: frozen(:)   !< parameters advanced without solving
     logical, intent(in), optional :: split
-    integer :: d(ndof_elem), e, k, i, j, n, ia, ib, b, g, mine
+    integer :: d(ndof_elem), e, k, i, j, n, ia, ib, b, g, mine, ng
     integer, allocatable :: owner(:), active(:), part(:), nfree(:), group(:)
     logical, allocatable :: free(:)
     real(dp), allocatable :: load(:)
@@ -62,20 +62,23 @@ contains
     do b = 1, model%nbody
       nfree(b) = count(free(7*model%body(b)%node_first - 6:7*model%body(b)%node_last))
     end do
-    ! groups: the largest body first to the least loaded group (replicated, so alike everywhere)
+    ! groups: as many as bodies (at most one per rank), unless the bodies do not share out
+    ! evenly: three equal spheres on two ranks ran slower as 2 + 1 than on one instance over
+    ! both ranks, which spreads the three elimination trees itself (docs/performance.md)
     asm%ngroups = 1
+    group = 0
     if (present(split)) then
-      if (split) asm%ngroups = max(1, min(n_ranks, count(nfree > 0)))
+      if (split) then
+        do ng = min(n_ranks, count(nfree > 0)), 2, -1
+          call deal(ng)
+          if (maxval(load) <= 1.1_dp*real(sum(nfree), dp)/n_ranks) then
+            asm%ngroups = ng
+            exit
+          end if
+        end do
+      end if
     end if
-    allocate (load(asm%ngroups))
-    load = 0; group = 0
-    do k = 1, model%nbody
-      b = maxloc(nfree, dim=1, mask=nfree > 0)
-      if (b == 0) exit
-      g = minloc(load, dim=1) - 1
-      group(b) = g; load(g + 1) = load(g + 1) + nfree(b)
-      nfree(b) = -nfree(b) - 1   ! taken
-    end do
+    if (asm%ngroups == 1) group = 0
     mine = mod(my_rank, asm%ngroups)
     asm%host = my_rank < asm%ngroups
 
@@ -144,6 +147,24 @@ contains
       end do
     end do
   contains
+    !> group(b) for ng groups: the largest body first to the group whose ranks are least
+    !> loaded; load(g) = unknowns per rank of group g (replicated, so alike everywhere)
+    subroutine deal(ng)
+      integer, intent(in) :: ng
+      integer :: left(model%nbody), size_g(ng), bb, gg
+      size_g = [((n_ranks - 1 - gg)/ng + 1, gg=0, ng - 1)]
+      if (allocated(load)) deallocate (load)
+      allocate (load(ng))
+      load = 0; group = 0; left = nfree
+      do
+        bb = maxloc(left, dim=1, mask=left > 0)
+        if (bb == 0) exit
+        gg = minloc(load + real(left(bb), dp)/size_g, dim=1)
+        group(bb) = gg - 1; load(gg) = load(gg) + real(left(bb), dp)/size_g(gg)
+        left(bb) = 0
+      end do
+    end subroutine deal
+
     !> part(idx) = 0..nparts-1: group g's active elements active(idx) over its nparts ranks
     subroutine partition_into(idx, nparts)
       integer, intent(in) :: idx(:), nparts
