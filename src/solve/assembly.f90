@@ -7,7 +7,8 @@
 !> are dealt to groups of ranks (as many as bodies, up to one rank each) and each group
 !> factorises and solves its own block: the solves, which dominate a long run, then need no
 !> communication at all. Two equal bodies on two ranks solve twice as fast, where one MUMPS
-!> instance over both ranks solves 1.2x as fast (docs/performance.md).
+!> instance over both ranks solves 1.5x as fast; bodies that do not share out evenly stay in
+!> one instance (docs/performance.md).
 module casca_assembly
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
