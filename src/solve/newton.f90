@@ -78,7 +78,7 @@ contains
       call timer_start(t_contact)
       if (present(contact)) then
         call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
-                            reproject=it <= 2)
+                            reproject=it <= 1)
         nc = contact%nact
         call contact_rows(contact, model, asm%eq, asm%neq, cirn, cjcn, cval, gap)
       else
