@@ -45,6 +45,8 @@ module casca_surface_search
     integer, allocatable :: entry_tri(:)   ! (nentry) sub-triangle; capacity may exceed
     real(dp), allocatable :: entry_box(:, :)  ! (6, nentry) its box: min corner, max corner
     integer, allocatable :: stamp(:)       ! (ntri) last query that evaluated the sub-triangle
+    integer, allocatable :: kept(:)        ! sub-triangles binned at the last build
+    real(dp), allocatable :: kept_box(:, :)   ! (6, ntri) their boxes: min corner, max corner
     integer :: query = 0
   end type grid_t
 
@@ -89,7 +91,7 @@ contains
     type(grid_t), intent(inout) :: grid
     real(dp), intent(in), optional :: within(3, 2)
     real(dp) :: ext(3), hcell, cap, ncell_r, nd(3), blo(3), bhi(3)
-    integer :: it, k, ncell, nentry, i0(3), i1(3), i, j, l, id, iter, pos, nkept
+    integer :: it, k, ncell, nentry, id, iter, nkept
 
     grid%ntri = surf%ntri
     if (allocated(grid%stamp)) then
@@ -102,12 +104,19 @@ contains
     ! Box of the surface and mean sub-triangle size.
     grid%lo = huge(1.0_dp)
     grid%hi = -huge(1.0_dp)
+    ! The kept sub-triangles and their boxes, once: both binning passes read them.
     hcell = 0.0_dp
     nkept = 0
+    call ensure_int(grid%kept, surf%ntri)
+    call ensure_real6(grid%kept_box, surf%ntri)
     do it = 1, surf%ntri
       call tri_box(surf, x, it, blo, bhi)
-      if (.not. kept()) cycle
+      if (present(within)) then
+        if (any(blo > within(:, 2)) .or. any(bhi < within(:, 1))) cycle
+      end if
       nkept = nkept + 1
+      grid%kept(nkept) = it
+      grid%kept_box(1:3, nkept) = blo; grid%kept_box(4:6, nkept) = bhi
       grid%lo = min(grid%lo, blo)
       grid%hi = max(grid%hi, bhi)
       hcell = hcell + maxval(bhi - blo)
@@ -150,20 +159,7 @@ contains
     ! Counting sort of (cell, sub-triangle) pairs into CSR: count, prefix sum, fill.
     grid%cell_start(1:ncell + 1) = 0
     nentry = 0
-    do it = 1, surf%ntri
-      call tri_box(surf, x, it, blo, bhi)
-      if (.not. kept()) cycle
-      call cell_range(grid, blo, bhi, i0, i1)
-      do l = i0(3), i1(3)
-        do j = i0(2), i1(2)
-          do i = i0(1), i1(1)
-            id = cell_id(grid, i, j, l)
-            grid%cell_start(id + 1) = grid%cell_start(id + 1) + 1
-          end do
-        end do
-      end do
-      nentry = nentry + (i1(1) - i0(1) + 1)*(i1(2) - i0(2) + 1)*(i1(3) - i0(3) + 1)
-    end do
+    call bin(.false.)
     grid%cell_start(1) = 1
     do id = 1, ncell
       grid%cell_start(id + 1) = grid%cell_start(id + 1) + grid%cell_start(id)
@@ -171,32 +167,36 @@ contains
     call ensure_int(grid%entry_tri, nentry)
     call ensure_real6(grid%entry_box, nentry)
     ! cell_start(id) serves as the insertion cursor, then everything is shifted back by one.
-    do it = 1, surf%ntri
-      call tri_box(surf, x, it, blo, bhi)
-      if (.not. kept()) cycle
-      call cell_range(grid, blo, bhi, i0, i1)
-      do l = i0(3), i1(3)
-        do j = i0(2), i1(2)
-          do i = i0(1), i1(1)
-            id = cell_id(grid, i, j, l)
-            pos = grid%cell_start(id)
-            grid%entry_tri(pos) = it
-            grid%entry_box(1:3, pos) = blo
-            grid%entry_box(4:6, pos) = bhi
-            grid%cell_start(id) = pos + 1
-          end do
-        end do
-      end do
-    end do
+    call bin(.true.)
     do id = ncell, 1, -1
       grid%cell_start(id + 1) = grid%cell_start(id)
     end do
     grid%cell_start(1) = 1
   contains
-    logical function kept()
-      kept = .true.
-      if (present(within)) kept = all(blo <= within(:, 2)) .and. all(bhi >= within(:, 1))
-    end function kept
+    !> visit every (cell, kept sub-triangle) pair: count per cell, or fill the entries
+    subroutine bin(fill)
+      logical, intent(in) :: fill
+      integer :: m, i, j, l, i0(3), i1(3), pos
+      do m = 1, nkept
+        call cell_range(grid, grid%kept_box(1:3, m), grid%kept_box(4:6, m), i0, i1)
+        do l = i0(3), i1(3)
+          do j = i0(2), i1(2)
+            do i = i0(1), i1(1)
+              id = cell_id(grid, i, j, l)
+              if (fill) then
+                pos = grid%cell_start(id)
+                grid%entry_tri(pos) = grid%kept(m)
+                grid%entry_box(:, pos) = grid%kept_box(:, m)
+                grid%cell_start(id) = pos + 1
+              else
+                grid%cell_start(id + 1) = grid%cell_start(id + 1) + 1
+              end if
+            end do
+          end do
+        end do
+        if (.not. fill) nentry = nentry + product(i1 - i0 + 1)
+      end do
+    end subroutine bin
   end subroutine grid_build
 
   !> Nearest sub-triangle to p among those at distance <= rmax (found = .false. if none), the
