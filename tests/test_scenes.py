@@ -4,7 +4,7 @@ usage: test_scenes.py CASCA EXAMPLES_DIR WORK_DIR [--quick]
   strip_wall: 1D bar theory (contact 2L/c, force rho c v0 b h, rebound v0)
   two_rings:  momentum conservation, no penetration, touch then separate, inertia,
               same history on 1 and 2 ranks (each ring on its own rank)
-  three_rings: runs to completion; same history on 1 and 2 ranks (two rings on one rank)
+  three_rings: runs to completion; same history on 1 and 2 ranks (one MUMPS instance over both)
   three_spheres: shortened to 1.2 ms here (the README's command runs the whole scene): the
               spheres are 0.01 m apart at 10 m/s, so they first touch at t = 1 ms, and until
               they are within reach no body is solved; sphere 3 stays exactly where it was
@@ -63,7 +63,8 @@ ck.record("two_rings: inertia of every saddle-point factorisation = active const
           np.all(h["neg_pivots"][1:] == h["contacts"][1:]))
 
 # --- 1 and 2 ranks: same tracked-node history (first 8 ms: contact included). On 2 ranks the
-# bodies are dealt to the ranks (two rings: one each; three rings: two and one)
+# two rings are dealt one to each rank; three rings do not share out evenly and stay in one
+# MUMPS instance over both ranks
 def same_on_1_and_2_ranks(name):
     short = deck_variant(os.path.join(examples, name + ".nml"), os.path.join(work, name + "8.nml"),
                          t_end="0.008")

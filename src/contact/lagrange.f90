@@ -106,6 +106,7 @@ contains
     type(constraint_t) :: cn
 
     added = 0
+    allocate (x(3, model%nnode))
     x = positions(model, q)
     c%grid_ok = .false.
     ! active constraints: project again (the target moves and the node slides)
@@ -204,11 +205,12 @@ contains
     !> shape functions, cubic normal and gap at the constraint's xi
     subroutine finish(con)
       type(constraint_t), intent(inout) :: con
-      real(dp) :: dphi(10, 2), t1(3), t2(3), xt(3)
+      real(dp) :: dphi(10, 2), t1(3), t2(3), xt(3), xe(3, 10)
       call tri10_shape(con%xi(1), con%xi(2), con%shp, dphi)
-      xt = matmul(x(:, model%conn(:, con%elem)), con%shp)
-      t1 = matmul(x(:, model%conn(:, con%elem)), dphi(:, 1))
-      t2 = matmul(x(:, model%conn(:, con%elem)), dphi(:, 2))
+      xe = x(:, model%conn(:, con%elem))   ! gathered once for the point and both tangents
+      xt = matmul(xe, con%shp)
+      t1 = matmul(xe, dphi(:, 1))
+      t2 = matmul(xe, dphi(:, 2))
       con%n = cross(t1, t2)
       con%n = con%n/norm2(con%n)
       con%gap = dot_product(x(:, con%node) - xt, con%n)

@@ -26,7 +26,7 @@ module casca_assembly
     integer :: ngroups = 1                 !< groups of ranks, each with its bodies' block of K
     logical :: host = .true.               !< first rank of its group (holds b and x)
     integer, allocatable :: eq(:)          !< (ndof) equation in this rank's group, else 0
-    integer, allocatable :: elems(:)       !< this rank's elements with unknowns
+    integer, allocatable :: elems(:)       !< this rank's elements of its group (the tangent)
     integer, allocatable :: owned(:)       !< this rank's elements for accounting (all bodies)
     integer, allocatable :: dealt(:)       !< elements with unknowns dealt round all ranks:
                                            !< force-only assembly and strain energy, balanced
@@ -67,7 +67,6 @@ contains
     ! evenly: three equal spheres on two ranks ran slower as 2 + 1 than on one instance over
     ! both ranks, which spreads the three elimination trees itself (docs/performance.md)
     asm%ngroups = 1
-    group = 0
     if (present(split)) then
       if (split) then
         do ng = min(n_ranks, count(nfree > 0)), 2, -1
