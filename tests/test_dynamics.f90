@@ -9,7 +9,7 @@ program test_dynamics
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_plate, mesh_sphere
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
-  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_assembly, only: assembly_t, assembly_setup, nblocks
   use casca_mumps_solver, only: sparse_solver_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_newmark, only: state_t, newmark_t, newmark_step
@@ -81,7 +81,7 @@ contains
     type(mesh_t) :: mesh
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver
+    type(sparse_solver_t) :: solver(nblocks)
     type(error_t), allocatable :: err
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
@@ -121,7 +121,7 @@ contains
       end if
       wold = w
     end do
-    call solver%finish()
+    call solver(1)%finish()   ! one rank: block 1 only
     period = 2*(tcross(ncross) - tcross(1))/(ncross - 1)   ! crossings are half a period apart
     if (is_root()) print '(a,i0,a,f10.6,a,f10.6)', 'zero crossings: ', ncross, &
       ', omega = ', 2*pi/period, ', Euler-Bernoulli: ', omega
@@ -139,7 +139,7 @@ contains
     type(mesh_t) :: mesh
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver
+    type(sparse_solver_t) :: solver(nblocks)
     type(error_t), allocatable :: err
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
@@ -175,7 +175,7 @@ contains
       dl = max(dl, norm2(b%l - b0%l)/norm2(b0%l))
       de = max(de, abs(b%total - b0%total)/b0%total)
     end do
-    call solver%finish()
+    call solver(1)%finish()   ! one rank: block 1 only
     if (present(qout)) qout = st%q
   end subroutine free_flight
 

@@ -39,13 +39,13 @@ module casca_contact
     integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
     real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
     logical :: schur = .true.                   !< solve through the Schur complement of K
-    ! Schur cache: Z = K^-1 C^T (group hosts, their block) and S = C Z (LU, every rank) for
-    ! the constraints (z_node, z_elem), their rows (z_irn, z_jcn, z_val) and the
-    ! factorisation z_factor of K they were computed with
+    ! Schur cache: Z = K^-1 C^T (block hosts, their rows) and S = C Z (LU, every rank) for
+    ! the constraints (z_node, z_elem) and their rows (z_irn, z_jcn, z_val), made with the
+    ! factors of K in use while z_current
     real(dp), allocatable :: z(:, :), s(:, :)
     integer, allocatable :: z_irn(:), z_jcn(:), z_ipiv(:), z_node(:), z_elem(:)
     real(dp), allocatable :: z_val(:)
-    integer :: z_factor = -1
+    logical :: z_current = .false.
     integer :: z_positive = 0                   !< positive eigenvalues of S
   end type contact_t
 

@@ -7,7 +7,7 @@ module casca_run
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs
   use casca_model, only: model_t, reference_state, dof
-  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_assembly, only: assembly_t, assembly_setup, nblocks
   use casca_mumps_solver, only: sparse_solver_t
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
@@ -58,7 +58,7 @@ contains
       integer, allocatable :: pairs(:, :)
       integer :: added, k, worst
       character(len=256) :: msg
-      pairs = contact_pairs(deck, model)
+      allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
       if (size(pairs, 2) == 0) return
       call contact_init(model, pairs, deck%contact%tolerance*model%length, probe)
       allocate (q(model%ndof))
@@ -83,7 +83,7 @@ contains
     type(deck_t) :: deck
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver
+    type(sparse_solver_t) :: solver(nblocks)   !< one per block of K (casca_assembly)
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
@@ -182,6 +182,8 @@ contains
     end if
     if (is_root() .and. .not. quiet) print '(a,i0,a,i0,a,i0,a,i0,a)', 'casca: ', model%nbody, &
       ' bodies, ', model%nelem, ' elements, ', asm%neq_total, ' unknowns, ', n_ranks, ' rank(s)'
+    if (is_root() .and. .not. quiet .and. n_ranks > 1) print '(a,*(a,:,"; "))', &
+      'casca: bodies solved on ', (trim(model%body(k)%name)//': '//ranks_of(k), k=1, model%nbody)
 
     total_newton = 0
     allocate (frozen(model%ndof), idle(model%nbody))
@@ -257,8 +259,29 @@ contains
       if (all(fz .eqv. frozen)) return
       frozen = fz
       call assembly_setup(model, asm, err, frozen, split_bodies())
-      call solver%new_pattern()
+      do b = 1, nblocks
+        call solver(b)%new_pattern()
+      end do
     end subroutine update_frozen
+
+    !> The ranks that factorise and solve body b's block (when every body is solved)
+    function ranks_of(b) result(str)
+      integer, intent(in) :: b
+      character(len=:), allocatable :: str
+      character(len=12) :: num
+      integer :: r
+      if (asm%ngroups == 1) then
+        str = 'all ranks, one instance'
+      else if (asm%group(b) < 0) then
+        str = 'all ranks, shared'
+      else
+        str = 'rank'
+        do r = asm%group(b), n_ranks - 1, asm%ngroups
+          write (num, '(i0)') r
+          str = str//' '//trim(num)
+        end do
+      end if
+    end function ranks_of
 
     !> K is block diagonal by body unless the constraints are factorised with it ('saddle')
     logical function split_bodies()
@@ -268,7 +291,7 @@ contains
 
     subroutine setup_contact()
       integer, allocatable :: pairs(:, :)
-      pairs = contact_pairs(deck, model)
+      allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
       use_contact = size(pairs, 2) > 0
       if (use_contact) then
         call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
@@ -323,7 +346,10 @@ contains
 
     subroutine checkpoint()
       type(error_t), allocatable :: e
-      call solver%drop_factors()   ! on every rank: a restart from here starts with new factors
+      integer :: s
+      do s = 1, nblocks   ! on every rank: a restart from here starts with new factors
+        call solver(s)%drop_factors()
+      end do
       if (.not. is_root()) return
       if (use_contact) then
         call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, &

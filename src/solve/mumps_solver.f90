@@ -26,7 +26,6 @@ module casca_mumps_solver
     integer :: ngroups = 1          !< the ranks are dealt into this many groups (one instance each)
     logical :: analysed = .false.
     logical :: factored = .false.   !< holds factors of the analysed pattern
-    integer :: factorisations = 0   !< counter: tells whether factors changed
     !> ICNTL(7): 7 = MUMPS chooses (PORD here), 1 = METIS nested dissection given by casca;
     !> equal within 3% on the 720-element sphere (docs/performance.md), so MUMPS chooses
     integer :: ordering = 7
@@ -35,7 +34,6 @@ module casca_mumps_solver
     procedure :: analyse => solver_analyse
     procedure :: factorise => solver_factorise
     procedure :: solve => solver_solve
-    procedure :: solve_many => solver_solve_many
     procedure :: negative_pivots => solver_negative_pivots
     procedure :: host => solver_host
     procedure :: drop_factors => solver_drop_factors
@@ -116,33 +114,11 @@ contains
     end do
     call check(self, 'factorisation', err)
     self%factored = .not. allocated(err)
-    self%factorisations = self%factorisations + 1
   end subroutine solver_factorise
 
-  !> x = K^-1 b; b needed on the host only, x returned on the host (zero elsewhere).
+  !> X = K^-1 B for m right-hand sides at once (B, X: (n, m)); B is needed on the host only,
+  !> X is returned on the host (zero elsewhere).
   subroutine solver_solve(self, b, x, err)
-    class(sparse_solver_t), intent(inout) :: self
-    real(dp), intent(in) :: b(:)
-    real(dp), intent(out) :: x(:)
-    type(error_t), allocatable, intent(out) :: err
-    if (self%host()) then
-      if (associated(self%id%rhs)) then
-        if (size(self%id%rhs) /= size(b)) deallocate (self%id%rhs)
-      end if
-      if (.not. associated(self%id%rhs)) allocate (self%id%rhs(size(b)))
-      self%id%rhs = b
-    end if
-    self%id%job = 3
-    call dmumps(self%id)
-    call check(self, 'solution', err)
-    if (allocated(err)) return
-    x = 0
-    if (self%host()) x = self%id%rhs
-  end subroutine solver_solve
-
-  !> X = K^-1 B for several right-hand sides at once (B, X: (n, m) on the host; X is
-  !> returned on the host only).
-  subroutine solver_solve_many(self, b, x, err)
     class(sparse_solver_t), intent(inout) :: self
     real(dp), intent(in) :: b(:, :)
     real(dp), intent(out) :: x(:, :)
@@ -150,18 +126,19 @@ contains
     integer :: n, m
     n = size(b, 1); m = size(b, 2)
     if (self%host()) then
-      if (associated(self%id%rhs)) deallocate (self%id%rhs)
-      allocate (self%id%rhs(n*m))
+      if (associated(self%id%rhs)) then
+        if (size(self%id%rhs) /= n*m) deallocate (self%id%rhs)
+      end if
+      if (.not. associated(self%id%rhs)) allocate (self%id%rhs(n*m))
       self%id%rhs = reshape(b, [n*m])
     end if
     self%id%nrhs = m; self%id%lrhs = n
     self%id%job = 3
     call dmumps(self%id)
-    self%id%nrhs = 1
     call check(self, 'solution', err)
-    if (allocated(err)) return
-    if (self%host()) x = reshape(self%id%rhs, [n, m])
-  end subroutine solver_solve_many
+    x = 0
+    if (self%host() .and. .not. allocated(err)) x = reshape(self%id%rhs, [n, m])
+  end subroutine solver_solve
 
   !> Negative pivots of the last factorisation (the inertia of a saddle-point matrix).
   integer function solver_negative_pivots(self)

@@ -4,7 +4,7 @@ module casca_newmark
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t
-  use casca_assembly, only: assembly_t
+  use casca_assembly, only: assembly_t, nblocks
   use casca_mumps_solver, only: sparse_solver_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_contact, only: contact_t, constraint_t, contact_persistency
@@ -30,7 +30,7 @@ contains
   subroutine newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
-    type(sparse_solver_t), intent(inout) :: solver
+    type(sparse_solver_t), intent(inout) :: solver(nblocks)
     type(newmark_t), intent(in) :: nm
     real(dp), intent(in) :: fext(:)
     type(newton_opts_t), intent(in) :: opts
@@ -43,6 +43,7 @@ contains
     type(constraint_t), allocatable :: saved(:)   ! the active set, kept for a failed step
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
+    allocate (qs, rs, q, mold=st%q)   ! (not on assignment: gfortran warns, falsely)
     qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*st%qdd
     rs = st%qd + dt*(1 - g)*st%qdd
     ! predictor: the step taken with zero new acceleration
@@ -78,7 +79,7 @@ contains
   subroutine static_solve(model, asm, solver, fext, nsteps, opts, q, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
-    type(sparse_solver_t), intent(inout) :: solver
+    type(sparse_solver_t), intent(inout) :: solver(nblocks)
     real(dp), intent(in) :: fext(:)
     integer, intent(in) :: nsteps
     type(newton_opts_t), intent(in) :: opts

@@ -6,7 +6,9 @@
 !> settled active set. By default (contact solver 'schur') the constraints are not put in the
 !> factorised matrix: K alone is factorised, with a pattern that never changes, and the system
 !> is solved through the Schur complement C K^-1 C^T; 'saddle' factorises the whole
-!> saddle-point matrix (re-analysed whenever the constraint pattern changes). With reuse, a factorisation is kept across iterations and steps while
+!> saddle-point matrix (re-analysed whenever the constraint pattern changes). K's diagonal
+!> blocks (casca_assembly) each have a MUMPS instance: solver(s) for block s. With reuse, a
+!> factorisation is kept across iterations and steps while
 !> each iteration shrinks the increment at least fourfold (modified Newton: only the force is
 !> assembled then); the incremental form above makes a stale matrix change the path, never
 !> the converged answer.
@@ -14,7 +16,7 @@ module casca_newton
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t
-  use casca_assembly, only: assembly_t, assemble
+  use casca_assembly, only: assembly_t, assemble, nblocks
   use casca_mumps_solver, only: sparse_solver_t
   use casca_contact, only: contact_t, contact_update, contact_release, contact_rows
   use casca_mpi, only: is_root, sum_all, share_error
@@ -50,7 +52,7 @@ contains
   subroutine newton_solve(model, asm, solver, q, fext, opts, rep, err, cm, qs, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
-    type(sparse_solver_t), intent(inout) :: solver
+    type(sparse_solver_t), intent(inout) :: solver(nblocks)
     real(dp), intent(inout) :: q(:)
     real(dp), intent(in) :: fext(:)
     type(newton_opts_t), intent(in) :: opts
@@ -58,9 +60,10 @@ contains
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: cm, qs(:)
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: r(:), x(:), b(:), cval(:), gap(:), cval_f(:), dq(:)
+    type(error_t), allocatable :: e
+    real(dp), allocatable :: x2(:, :), r(:), x(:), b(:), cval(:), gap(:), cval_f(:), dq(:)
     integer, allocatable :: cirn(:), cjcn(:), cirn_f(:), cjcn_f(:)
-    integer :: it, i, nc, added, released, k, schur_positive
+    integer :: it, i, nc, added, released, k, schur_positive, s
     real(dp) :: nrm
     logical :: settled, fresh, schur, renew_z
 
@@ -100,7 +103,7 @@ contains
       ! replicated figures, so alike on every rank). With constraints, slow contraction comes
       ! first from the constraint rows (their normal is held): the Schur cache is renewed
       ! first, K only if contraction stays poor.
-      fresh = .not. (opts%reuse .and. solver%factored)
+      fresh = .not. (opts%reuse .and. solver(1)%factored)   ! block 1: on every rank
       renew_z = .false.
       if (it >= 3) renew_z = rep%incr(it - 1) > 0.25_dp*rep%incr(it - 2)
       if (.not. fresh) then
@@ -117,48 +120,54 @@ contains
       call timer_stop(t_assembly)
       if (fresh) then
         call timer_start(t_factor)
-        if (asm%host) then
-          call solver%factorise([asm%a, cval_f], err)
-        else
-          call solver%factorise(asm%a, err)
-        end if
+        do s = 1, nblocks
+          if (asm%blk(s)%neq == 0) cycle
+          associate (a => asm%a(asm%blk(s)%first:asm%blk(s)%last))
+            if (asm%blk(s)%host) then   ! cval_f: 'saddle' only, which has one block
+              call solver(s)%factorise([a, cval_f], e)
+            else
+              call solver(s)%factorise(a, e)
+            end if
+          end associate
+          if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+        end do
         call timer_stop(t_factor)
-        call share_error(err)   ! the groups factorise apart: all go on, or none
+        call share_error(err)   ! the blocks factorise apart: all go on, or none
         if (allocated(err)) return
         rep%factorisations = rep%factorisations + 1
+        if (present(contact)) contact%z_current = .false.
       end if
 
       allocate (b(asm%neq + nc), x(asm%neq + nc))
       b = 0
-      if (asm%host) then
-        do i = 1, model%ndof
-          if (asm%eq(i) > 0) b(asm%eq(i)) = -r(i)
-        end do
-        do k = 1, size(cirn)   ! the multipliers' force C^T lambda, with the current rows
-          if (cirn(k) /= cjcn(k)) &
-            b(cjcn(k)) = b(cjcn(k)) - cval(k)*contact%act(cirn(k) - asm%neq)%lambda
-        end do
-        b(asm%neq + 1:) = -gap
-      end if
+      do i = 1, model%ndof
+        if (asm%eq(i) > 0) b(asm%eq(i)) = -r(i)
+      end do
+      do k = 1, size(cirn)   ! the multipliers' force C^T lambda, with the current rows
+        if (cirn(k) /= cjcn(k)) &
+          b(cjcn(k)) = b(cjcn(k)) - cval(k)*contact%act(cirn(k) - asm%neq)%lambda
+      end do
+      b(asm%neq + 1:) = -gap
       call timer_start(t_solve)
       if (schur .and. nc > 0) then
         call schur_solve()
       else
-        call solver%solve(b, x, err)
-        call share_error(err)
+        allocate (x2(size(b), 1))
+        call solve_blocks(reshape(b, [size(b), 1]), x2, nc)
+        x = x2(:, 1)
+        deallocate (x2)
       end if
       if (allocated(err)) then
         call timer_stop(t_solve); return
       end if
-      ! the whole increment on every rank: each host gives its group's part, rank 0 the
-      ! multipliers' (every rank has them with 'schur'; rank 0 is the only host with 'saddle')
+      ! the whole increment on every rank: each block's host gives its part (x is zero in
+      ! the blocks a rank does not host), rank 0 the multipliers' (every rank has them with
+      ! 'schur'; rank 0 is the only host with 'saddle')
       allocate (dq(model%ndof + nc))
       dq = 0
-      if (asm%host) then
-        do i = 1, model%ndof
-          if (asm%eq(i) > 0) dq(i) = x(asm%eq(i))
-        end do
-      end if
+      do i = 1, model%ndof
+        if (asm%eq(i) > 0) dq(i) = x(asm%eq(i))
+      end do
       if (is_root()) dq(model%ndof + 1:) = x(asm%neq + 1:)
       call sum_all(dq)
       call timer_stop(t_solve)
@@ -186,8 +195,11 @@ contains
       end if
       if (settled) then
         rep%converged = .true.
-        rep%neg_pivots = 0   ! of the factors in use, summed over the groups
-        if (asm%host) rep%neg_pivots = solver%negative_pivots()
+        rep%neg_pivots = 0   ! of the factors in use, summed over the blocks
+        do s = 1, nblocks
+          if (asm%blk(s)%neq > 0 .and. asm%blk(s)%host) &
+            rep%neg_pivots = rep%neg_pivots + solver(s)%negative_pivots()
+        end do
         call sum_all(rep%neg_pivots)
         if (schur .and. nc > 0) rep%neg_pivots = rep%neg_pivots + schur_positive
         return
@@ -209,22 +221,20 @@ contains
     !> The saddle-point system through the Schur complement of K: Z = K^-1 C^T, S = C Z,
     !> y = K^-1 b, S dlambda = C y + g, dq = y - Z dlambda. Z and S are kept (with the rows
     !> they were made from) while the constraints (node, element), K's factors and good
-    !> contraction stay, so most iterations cost one solve. Each group's host holds its block
-    !> of Z and y; S and C y are summed over the groups and S is factorised on every rank, so
-    !> dlambda is replicated. The inertia of the saddle-point matrix is that of K plus the
-    !> positive eigenvalues of S.
+    !> contraction stay, so most iterations cost one solve. Each block's host holds its rows
+    !> of Z and y (zero elsewhere); S and C y are summed over the ranks and S is factorised on
+    !> every rank, so dlambda is replicated. The inertia of the saddle-point matrix is that of
+    !> K plus the positive eigenvalues of S.
     subroutine schur_solve()
       real(dp), allocatable :: bb(:, :), yy(:, :), sc(:, :), rhs(:), eig(:), work(:), y(:)
       integer :: e, kk, info, lwork
       logical :: valid
       valid = .false.
-      if (allocated(contact%z_node)) then   ! replicated figures: every group decides alike
-        valid = .not. renew_z .and. contact%z_factor == solver%factorisations .and. &
-                size(contact%z_node) == nc
+      if (allocated(contact%z_node)) then   ! replicated figures: every rank decides alike
+        valid = .not. renew_z .and. contact%z_current .and. size(contact%z_node) == nc
         if (valid) valid = all(contact%z_node == contact%act(1:nc)%node) .and. &
                            all(contact%z_elem == contact%act(1:nc)%elem)
       end if
-      allocate (y(asm%neq))
       if (.not. valid) then   ! Z and S from the current rows: nc + 1 right-hand sides
         allocate (bb(asm%neq, nc + 1), yy(asm%neq, nc + 1))
         bb = 0
@@ -232,24 +242,21 @@ contains
         do e = 1, size(cirn)
           if (cirn(e) /= cjcn(e)) bb(cjcn(e), 1 + cirn(e) - asm%neq) = cval(e)
         end do
-        call solver%solve_many(bb, yy, err)
-        call share_error(err)
+        call solve_blocks(bb, yy, 0)
         if (allocated(err)) return
         contact%z_irn = cirn; contact%z_jcn = cjcn; contact%z_val = cval
         contact%z_node = contact%act(1:nc)%node; contact%z_elem = contact%act(1:nc)%elem
-        contact%z_factor = solver%factorisations
+        contact%z_current = .true.
+        contact%z = yy(:, 2:)
+        y = yy(:, 1)
         if (allocated(contact%s)) deallocate (contact%s)
         allocate (contact%s(nc, nc))
         contact%s = 0
-        if (asm%host) then
-          contact%z = yy(:, 2:)
-          y = yy(:, 1)
-          do e = 1, size(cirn)
-            if (cirn(e) == cjcn(e)) cycle
-            kk = cirn(e) - asm%neq
-            contact%s(kk, :) = contact%s(kk, :) + cval(e)*contact%z(cjcn(e), :)
-          end do
-        end if
+        do e = 1, size(cirn)
+          if (cirn(e) == cjcn(e)) cycle
+          kk = cirn(e) - asm%neq
+          contact%s(kk, :) = contact%s(kk, :) + cval(e)*contact%z(cjcn(e), :)
+        end do
         call sum_all(contact%s)
         contact%s = 0.5_dp*(contact%s + transpose(contact%s))
         sc = contact%s
@@ -262,19 +269,18 @@ contains
         call dgetrf(nc, nc, contact%s, nc, contact%z_ipiv, info)
         if (info /= 0) contact%z_ipiv = -1   ! dependent constraints: no correction
       else                    ! the kept Z and S: one right-hand side
-        call solver%solve(b(1:asm%neq), y, err)
-        call share_error(err)
+        allocate (yy(asm%neq, 1))
+        call solve_blocks(reshape(b(1:asm%neq), [asm%neq, 1]), yy, 0)
         if (allocated(err)) return
+        y = yy(:, 1)
       end if
       allocate (rhs(nc))
       rhs = 0   ! C_kept y + g: the matrix is [K, C_kept^T; C_kept, 0] throughout
-      if (asm%host) then
-        do e = 1, size(contact%z_irn)
-          if (contact%z_irn(e) == contact%z_jcn(e)) cycle
-          kk = contact%z_irn(e) - asm%neq
-          rhs(kk) = rhs(kk) + contact%z_val(e)*y(contact%z_jcn(e))
-        end do
-      end if
+      do e = 1, size(contact%z_irn)
+        if (contact%z_irn(e) == contact%z_jcn(e)) cycle
+        kk = contact%z_irn(e) - asm%neq
+        rhs(kk) = rhs(kk) + contact%z_val(e)*y(contact%z_jcn(e))
+      end do
       call sum_all(rhs)
       rhs = rhs + gap
       if (contact%z_ipiv(1) > 0) then
@@ -282,35 +288,62 @@ contains
       else
         rhs = 0
       end if
-      if (asm%host) x(1:asm%neq) = y - matmul(contact%z, rhs)
+      x(1:asm%neq) = y - matmul(contact%z, rhs)
       x(asm%neq + 1:) = rhs
       schur_positive = contact%z_positive
     end subroutine schur_solve
 
+    !> xx = K^-1 bb block by block (rows: this rank's equations, then, with 'saddle', the
+    !> extra multipliers of its one block); zero in the blocks this rank does not host.
+    !> Every block is solved before the errors are shared: a block over several ranks is
+    !> collective, so a rank that stopped early would leave the others waiting.
+    subroutine solve_blocks(bb, xx, extra)
+      real(dp), intent(in) :: bb(:, :)
+      real(dp), intent(out) :: xx(:, :)
+      integer, intent(in) :: extra
+      integer :: lo, hi, s
+      xx = 0
+      do s = 1, nblocks
+        if (asm%blk(s)%neq == 0) cycle
+        lo = asm%blk(s)%off + 1
+        hi = asm%blk(s)%off + asm%blk(s)%neq + merge(extra, 0, s == 1)
+        call solver(s)%solve(bb(lo:hi, :), xx(lo:hi, :), e)
+        if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+      end do
+      call share_error(err)
+    end subroutine solve_blocks
 
-    !> symbolic analysis at the first solve and whenever the constraint rows change
+    !> symbolic analysis of each block at its first solve and whenever the constraint rows
+    !> in the matrix change ('saddle', whose one block has them after K's equations)
     subroutine analyse_if_needed()
-      integer, allocatable :: perm(:)
-      integer :: nf
-      if (solver%analysed) then
-        if (.not. present(contact)) return
-        if (same_pattern()) return
-      end if
-      allocate (perm(0))
+      integer, allocatable :: perm(:), irn(:), jcn(:)
+      integer :: nf, n, off
+      logical :: same
+      same = .true.
+      if (present(contact)) same = same_pattern()
       nf = count(cirn_f == cjcn_f)   ! multipliers inside the factorised matrix
-      if (solver%ordering == 1 .and. asm%host) then
-        deallocate (perm); allocate (perm(asm%neq + nf))
-        call nested_dissection(model%conn, model%nnode, asm%eq, asm%neq, perm, err)
-        if (allocated(err)) return
-        perm(asm%neq + 1:) = [(asm%neq + i, i=1, nf)]   ! multipliers last
-      end if
-      if (asm%host) then
-        call solver%analyse(asm%neq + nf, [asm%irn, cirn_f], [asm%jcn, cjcn_f], perm, err, &
-                            asm%ngroups)
-      else
-        call solver%analyse(asm%neq + nf, asm%irn, asm%jcn, perm, err, asm%ngroups)
-      end if
-      rep%analyses = rep%analyses + 1
+      do s = 1, nblocks
+        if (asm%blk(s)%neq == 0 .or. (solver(s)%analysed .and. same)) cycle
+        n = asm%blk(s)%neq; off = asm%blk(s)%off
+        irn = asm%irn(asm%blk(s)%first:asm%blk(s)%last)
+        jcn = asm%jcn(asm%blk(s)%first:asm%blk(s)%last)
+        if (s == 1) n = n + nf
+        if (s == 1 .and. asm%blk(s)%host) then
+          irn = [irn, cirn_f]; jcn = [jcn, cjcn_f]
+        end if
+        allocate (perm(0))
+        if (solver(s)%ordering == 1 .and. asm%blk(s)%host) then
+          deallocate (perm); allocate (perm(n))
+          call nested_dissection(model%conn, model%nnode, &
+                                 merge(asm%eq - off, 0, asm%eq > off .and. asm%eq <= off + asm%blk(s)%neq), &
+                                 asm%blk(s)%neq, perm, e)
+          perm(asm%blk(s)%neq + 1:) = [(asm%blk(s)%neq + i, i=1, nf)]   ! multipliers last
+        end if
+        if (.not. allocated(e)) call solver(s)%analyse(n, irn, jcn, perm, e, asm%blk(s)%ngroups)
+        if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+        deallocate (perm)
+        rep%analyses = rep%analyses + 1
+      end do
       if (present(contact)) then
         contact%last_irn = cirn_f; contact%last_jcn = cjcn_f
       end if

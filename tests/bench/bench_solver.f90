@@ -20,7 +20,7 @@ program bench_solver
   type(assembly_t) :: asm
   type(sparse_solver_t) :: solver
   type(error_t), allocatable :: err
-  real(dp), allocatable :: q(:), r(:), b(:), x(:), qs(:)
+  real(dp), allocatable :: q(:), r(:), qs(:), b(:, :), x(:, :)
   real(dp) :: qe(7, 10), fe(70), ke(70, 70), u, t0, t_el, t_as, t_fa, t_so, t_an, flops, t_f
   real(dp) :: gemm_rate
   real(dp), allocatable :: ga(:, :), gb(:, :), gc(:, :)
@@ -79,7 +79,7 @@ program bench_solver
   call solver%analyse(asm%neq, asm%irn, asm%jcn, perm, err)
   t_an = wall_time() - t0
   qs = 0*q
-  allocate (b(asm%neq), x(asm%neq))
+  allocate (b(asm%neq, 1), x(asm%neq, 1))
   t_as = 0; t_fa = 0; t_so = 0
   nrep = 3
   do i = 1, nrep
