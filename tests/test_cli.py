@@ -86,6 +86,7 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["overlap at the start", "ring1", "ring2"]),
     ("missing required value", lambda s: s.replace("young = 210e9, ", "", 1), ["young", "missing"]),
     ("unknown mesh kind", lambda s: s.replace("mesh = 'file'", "mesh = 'torus'", 1), ["torus", "mesh"]),
+    ("unknown contact normal", lambda s: s + "&contact\n normal = 'smooth'\n/\n", ["&contact", "normal", "nodal"]),
 ]
 for name, change, needles in cases:
     deck = os.path.join(work, "bad_%s.nml" % re.sub(r"\W+", "_", name))

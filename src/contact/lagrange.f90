@@ -2,13 +2,17 @@
 !> target body), every impactor node whose signed distance to the target's sub-triangles is
 !> negative gets one multiplier lambda and the condition
 !>     g = (x_imp - x_target(xi)) . n(xi) = 0,   x_target = N_j(xi) Y^j of the cubic element,
-!> with n the unit normal of the cubic target at xi (eq. 5.4), linearised with xi and n held
-!> (eq. 5.6). lambda < 0 is compression (the contact force on the impactor is -lambda n); a
-!> multiplier that turns tensile at convergence is released.
+!> with n the unit normal of the target at xi, linearised with xi and n held (eq. 5.6). The
+!> thesis takes the cubic element's own normal (eq. 5.4, normal = 'element'), which jumps
+!> across element edges: a node pressed onto an edge or a vertex is pushed sideways, onto the
+!> neighbour, and back, step after step. By default (normal = 'nodal') n interpolates nodal
+!> normals averaged over the elements at each node, continuous over the surface.
+!> lambda < 0 is compression (the contact force on the impactor is -lambda n); a multiplier
+!> that turns tensile at convergence is released.
 module casca_contact
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_shape_tri10, only: tri10_shape
+  use casca_shape_tri10, only: tri10_shape, tri10_node_xi
   use casca_vectors, only: cross
   use casca_surface_search, only: surface_t, grid_t, surface_init, grid_build, &
                                   nearest_subtriangle, subtri_parent_xi
@@ -39,6 +43,11 @@ module casca_contact
     integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
     real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
     logical :: schur = .true.                   !< solve through the Schur complement of K
+    logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
+    ! the target elements at node n: node_elem(node_start(n) : node_start(n+1) - 1), and which
+    ! of their nodes n is (node_loc); shape derivatives at the 10 nodes (dphi_node)
+    integer, allocatable :: node_start(:), node_elem(:), node_loc(:)
+    real(dp) :: dphi_node(10, 2, 10) = 0
     ! Schur cache: Z = K^-1 C^T (block hosts, their rows) and S = C Z (LU, every rank) for
     ! the constraints (z_node, z_elem) and their rows (z_irn, z_jcn, z_val), made with the
     ! factors of K in use while z_current
@@ -57,8 +66,9 @@ contains
     integer, intent(in) :: pairs(:, :)
     real(dp), intent(in) :: tol
     type(contact_t), intent(out) :: c
-    integer :: b, e, k
-    real(dp) :: edge
+    integer :: b, e, k, n
+    real(dp) :: edge, phi(10)
+    logical, allocatable :: target_elem(:)
     c%npairs = size(pairs, 2)
     c%pair = pairs
     c%tol = tol
@@ -85,6 +95,33 @@ contains
         end do
         c%depth(b) = 0.5_dp*edge/c%surf(b)%ntri
       end associate
+    end do
+    ! the elements of the targets at each node (counted, then filled)
+    allocate (target_elem(model%nelem), c%node_start(model%nnode + 1))
+    target_elem = .false.
+    do b = 1, model%nbody
+      if (any(pairs(2, :) == b)) target_elem(model%body(b)%elem_first:model%body(b)%elem_last) = .true.
+    end do
+    c%node_start = 0
+    do e = 1, model%nelem
+      if (target_elem(e)) c%node_start(model%conn(:, e) + 1) = c%node_start(model%conn(:, e) + 1) + 1
+    end do
+    c%node_start(1) = 1
+    do n = 1, model%nnode
+      c%node_start(n + 1) = c%node_start(n + 1) + c%node_start(n)
+    end do
+    allocate (c%node_elem(c%node_start(model%nnode + 1) - 1), c%node_loc(c%node_start(model%nnode + 1) - 1))
+    do e = 1, model%nelem
+      if (.not. target_elem(e)) cycle
+      do k = 1, 10
+        n = model%conn(k, e)
+        c%node_elem(c%node_start(n)) = e; c%node_loc(c%node_start(n)) = k
+        c%node_start(n) = c%node_start(n) + 1
+      end do
+    end do
+    c%node_start(2:) = c%node_start(1:model%nnode); c%node_start(1) = 1
+    do k = 1, 10
+      call tri10_shape(tri10_node_xi(1, k), tri10_node_xi(2, k), phi, c%dphi_node(:, :, k))
     end do
   end subroutine contact_init
 
@@ -119,6 +156,7 @@ contains
       end if
       call project(c%act(k)%node, c%act(k)%pair, cn, sd, found)
       if (found) then
+        call finish(cn)
         cn%lambda = c%act(k)%lambda
         c%act(k) = cn
       else   ! far from every sub-triangle within the band: keep the last projection
@@ -137,6 +175,7 @@ contains
         call project(n, ip, cn, sd, found)
         if (.not. found) cycle
         if (sd < -c%tol .and. has_free_position(n, cn%elem)) then
+          call finish(cn)
           call push(cn)
           added = added + 1
         end if
@@ -173,7 +212,8 @@ contains
                             all(model%fixed(dof(model%conn(:, e), 3))))
     end function has_free_position
 
-    !> signed distance of node to the target of pair p, and the constraint it would carry
+    !> signed distance of node to the target of pair p, and the point of the constraint it
+    !> would carry (finish gives its normal and gap)
     subroutine project(node, p, con, sdist, ok)
       integer, intent(in) :: node, p
       type(constraint_t), intent(out) :: con
@@ -199,19 +239,31 @@ contains
       con%sd = sdist
       con%node = node; con%pair = p; con%elem = c%surf(b)%elem(itri)
       call subtri_parent_xi(c%surf(b), itri, bary, con%xi)
-      call finish(con)
     end subroutine project
 
-    !> shape functions, cubic normal and gap at the constraint's xi
+    !> shape functions, normal and gap at the constraint's xi
     subroutine finish(con)
       type(constraint_t), intent(inout) :: con
-      real(dp) :: dphi(10, 2), t1(3), t2(3), xt(3), xe(3, 10)
+      real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3)
+      integer :: j, i, nd
       call tri10_shape(con%xi(1), con%xi(2), con%shp, dphi)
       xe = x(:, model%conn(:, con%elem))   ! gathered once for the point and both tangents
       xt = matmul(xe, con%shp)
-      t1 = matmul(xe, dphi(:, 1))
-      t2 = matmul(xe, dphi(:, 2))
-      con%n = cross(t1, t2)
+      if (c%nodal_normal) then
+        con%n = 0
+        do j = 1, 10
+          nd = model%conn(j, con%elem)
+          own = unit_normal(xe, c%dphi_node(:, :, j))
+          m = 0   ! the normals of the elements at node j, turned to this element's side
+          do i = c%node_start(nd), c%node_start(nd + 1) - 1
+            ne = unit_normal(x(:, model%conn(:, c%node_elem(i))), c%dphi_node(:, :, c%node_loc(i)))
+            m = m + sign(1._dp, dot_product(ne, own))*ne
+          end do
+          con%n = con%n + (con%shp(j)/norm2(m))*m
+        end do
+      else
+        con%n = unit_normal(xe, dphi)
+      end if
       con%n = con%n/norm2(con%n)
       con%gap = dot_product(x(:, con%node) - xt, con%n)
     end subroutine finish
@@ -374,6 +426,7 @@ contains
     allocate (probe%grid(c%npairs), probe%grid_ok(c%npairs), probe%act(16))
     probe%grid_ok = .false.
     probe%tol = tol
+    probe%nodal_normal = .false.   ! the probes read signed distances only
   end subroutine new_probe
 
   !> Total normal contact force (sum of the compressive multipliers).
@@ -398,6 +451,14 @@ contains
       end associate
     end do
   end subroutine contact_nodal_fields
+
+  !> Unit normal of the cubic surface with node positions xe where the shape derivatives are dphi
+  pure function unit_normal(xe, dphi) result(n)
+    real(dp), intent(in) :: xe(3, 10), dphi(10, 2)
+    real(dp) :: n(3)
+    n = cross(matmul(xe, dphi(:, 1)), matmul(xe, dphi(:, 2)))
+    n = n/norm2(n)
+  end function unit_normal
 
   pure function positions(model, q) result(x)
     type(model_t), intent(in) :: model

@@ -296,6 +296,7 @@ contains
       if (use_contact) then
         call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
         contact%schur = deck%contact%solver == 'schur'
+        contact%nodal_normal = deck%contact%normal == 'nodal'
       end if
     end subroutine setup_contact
 

@@ -85,6 +85,7 @@ module casca_deck
     character(len=64) :: pairs(2, max_pairs) = ''
     real(dp) :: tolerance = 1e-7_dp             !< penetration accepted, relative to scene size
     character(len=16) :: solver = 'schur'       !< 'schur' or 'saddle' (docs/method.md)
+    character(len=16) :: normal = 'nodal'       !< 'nodal' or 'element' (docs/method.md)
     integer :: line = 0
   end type contact_cfg_t
 
@@ -394,12 +395,12 @@ contains
     logical :: enabled
     character(len=64) :: pairs(2, max_pairs)
     real(dp) :: tolerance
-    character(len=16) :: solver
+    character(len=16) :: solver, normal
     character(len=256) :: msg
     integer :: ios, k
-    namelist /contact/ enabled, pairs, tolerance, solver
+    namelist /contact/ enabled, pairs, tolerance, solver, normal
     associate (c => deck%contact)
-      enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver
+      enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver; normal = c%normal
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -408,6 +409,7 @@ contains
         call add_problem(deck, line, '&contact: '//trim(msg)); return
       end if
       c%enabled = enabled; c%tolerance = tolerance; c%pairs = pairs; c%solver = lower(solver)
+      c%normal = lower(normal)
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit

@@ -48,7 +48,7 @@ contains
       end select
     case ('contact')
       select case (key)
-      case ('pairs', 'solver'); t = 's'
+      case ('pairs', 'solver', 'normal'); t = 's'
       case ('tolerance'); t = 'r'
       case ('enabled'); t = 'l'
       end select
@@ -222,7 +222,7 @@ contains
       'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
       'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
       'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &
-      'force', 'pairs', 'tolerance', 'enabled', 'solver', 'nodes']
+      'force', 'pairs', 'tolerance', 'enabled', 'solver', 'normal', 'nodes']
     integer :: i, d, best
     s = ''
     best = 3

@@ -136,6 +136,8 @@ contains
     call positive(deck%contact%line, '&contact: tolerance', deck%contact%tolerance)
     if (deck%contact%solver /= 'schur' .and. deck%contact%solver /= 'saddle') &
       call add_problem(deck, deck%contact%line, '&contact: solver must be ''schur'' or ''saddle''')
+    if (deck%contact%normal /= 'nodal' .and. deck%contact%normal /= 'element') &
+      call add_problem(deck, deck%contact%line, '&contact: normal must be ''nodal'' or ''element''')
   contains
     subroutine positive(line, field, v)
       integer, intent(in) :: line
