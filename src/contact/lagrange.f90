@@ -12,7 +12,7 @@
 module casca_contact
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_shape_tri10, only: tri10_shape, tri10_node_xi
+  use casca_shape_tri10, only: tri10_shape, tri10_normal, tri10_node_xi
   use casca_vectors, only: cross
   use casca_surface_search, only: surface_t, grid_t, surface_init, grid_build, &
                                   nearest_subtriangle, subtri_parent_xi
@@ -456,7 +456,7 @@ contains
   pure function unit_normal(xe, dphi) result(n)
     real(dp), intent(in) :: xe(3, 10), dphi(10, 2)
     real(dp) :: n(3)
-    n = cross(matmul(xe, dphi(:, 1)), matmul(xe, dphi(:, 2)))
+    n = tri10_normal(xe, dphi)
     n = n/norm2(n)
   end function unit_normal
 

@@ -1,9 +1,10 @@
 !> Cubic Lagrange shape functions of the 10-node triangle (node order: see casca_mesh).
 module casca_shape_tri10
   use casca_kinds, only: dp
+  use casca_vectors, only: cross
   implicit none
   private
-  public :: tri10_shape, tri10_node_xi, subtri10
+  public :: tri10_shape, tri10_normal, tri10_node_xi, subtri10
 
   !> Reference coordinates (xi1, xi2) of the 10 nodes.
   real(dp), parameter :: tri10_node_xi(2, 10) = reshape([ &
@@ -48,4 +49,12 @@ contains
     phi(10) = 27*l(1)*l(2)*l(3)
     dphi(10, :) = 27*(l(2)*l(3)*dl(1, :) + l(1)*l(3)*dl(2, :) + l(1)*l(2)*dl(3, :))
   end subroutine tri10_shape
+
+  !> Normal of the cubic surface through the 10 points xe, where the shape derivatives are
+  !> dphi: the cross product of the two tangents (its length is the area Jacobian).
+  pure function tri10_normal(xe, dphi) result(n)
+    real(dp), intent(in) :: xe(3, 10), dphi(10, 2)
+    real(dp) :: n(3)
+    n = cross(matmul(xe, dphi(:, 1)), matmul(xe, dphi(:, 2)))
+  end function tri10_normal
 end module casca_shape_tri10

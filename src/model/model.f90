@@ -5,8 +5,7 @@ module casca_model
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
-  use casca_vectors, only: cross
-  use casca_shape_tri10, only: tri10_shape, tri10_node_xi
+  use casca_shape_tri10, only: tri10_shape, tri10_normal, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, shell_mass, &
                                  svk_lame, ndof_node
   implicit none
@@ -107,7 +106,7 @@ contains
     type(model_t), intent(inout) :: model
     type(error_t), allocatable, intent(out) :: err
     type(shell_rule_t) :: mrule
-    real(dp) :: phi(10), dphi(10, 2), t1(3), t2(3), detmin, h
+    real(dp) :: phi(10), dphi(10, 2), detmin, h
     integer :: e, l, i
     character(len=200) :: msg
 
@@ -123,9 +122,7 @@ contains
         i = model%conn(l, e)
         if (model%exact_normal(i)) cycle
         call tri10_shape(tri10_node_xi(1, l), tri10_node_xi(2, l), phi, dphi)
-        t1 = matmul(model%x0(:, model%conn(:, e)), dphi(:, 1))
-        t2 = matmul(model%x0(:, model%conn(:, e)), dphi(:, 2))
-        model%v0(:, i) = model%v0(:, i) + cross(t1, t2)
+        model%v0(:, i) = model%v0(:, i) + tri10_normal(model%x0(:, model%conn(:, e)), dphi)
       end do
     end do
     do i = 1, model%nnode
