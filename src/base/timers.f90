@@ -4,7 +4,7 @@ module casca_timers
   use casca_mpi, only: wall_time
   implicit none
   private
-  public :: timer_start, timer_stop, timer_report, t_assembly, t_contact, t_analysis, &
+  public :: timer_start, timer_stop, timer_report, seconds, t_assembly, t_contact, t_analysis, &
             t_factor, t_solve, t_account, t_output, ntimers
 
   integer, parameter :: t_assembly = 1, t_contact = 2, t_analysis = 3, t_factor = 4, &
@@ -33,10 +33,19 @@ contains
     integer :: i
     s = 'time:'
     do i = 1, ntimers
-      write (b, '(1x,a,1x,f0.2,a,i0,a)') trim(names(i)), total(i), ' s (', &
-        nint(100*total(i)/max(wall, tiny(1._dp))), '%)'
-      s = s//trim(b)
+      write (b, '(a,i0,a)') ' s (', nint(100*total(i)/max(wall, tiny(1._dp))), '%)'
+      s = s//' '//trim(names(i))//' '//seconds(total(i))//trim(b)
       if (i < ntimers) s = s//','
     end do
   end function timer_report
+
+  !> Seconds with two decimals and a leading zero (f0.2 writes 0.67 as '.67').
+  pure function seconds(t) result(s)
+    real(dp), intent(in) :: t
+    character(len=:), allocatable :: s
+    character(len=24) :: b
+    write (b, '(f0.2)') t
+    s = trim(b)
+    if (s(1:1) == '.') s = '0'//s
+  end function seconds
 end module casca_timers

@@ -20,7 +20,7 @@ module casca_run
   use casca_plots, only: make_plots
   use casca_free_flight, only: idle_bodies, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks
-  use casca_timers, only: timer_start, timer_stop, timer_report, t_account, t_output
+  use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   implicit none
   private
   public :: load_scene, run_deck
@@ -395,7 +395,7 @@ contains
           '/plots.gp was written but not run'
       end if
       if (is_root() .and. .not. quiet) then
-        print '(a,i0,a,f0.2,a,a)', 'done: ', st%step, ' steps in ', wall_time() - t0, &
+        print '(a,i0,a,a,a,a)', 'done: ', st%step, ' steps in ', seconds(wall_time() - t0), &
           ' s; results in ', dir
         print '(a)', timer_report(wall_time() - t0)
       end if

@@ -288,6 +288,8 @@ contains
     character(len=1024), allocatable :: text(:)
     character(len=16) :: name
     integer :: ios, n, j, k
+    integer, allocatable :: lines(:)
+    character(len=512), allocatable :: msgs(:)
 
     allocate (gname(0), gline(0), text(0))
     n = 0
@@ -314,14 +316,11 @@ contains
     end do
     rewind (u)
     do k = 1, size(gname)
-      call lint_group(text, gline(k), trim(gname(k)), report)
+      call lint_group(text, gline(k), trim(gname(k)), lines, msgs)
+      do j = 1, size(lines)
+        call add_problem(deck, lines(j), trim(msgs(j)))
+      end do
     end do
-  contains
-    subroutine report(line_no, msg)
-      integer, intent(in) :: line_no
-      character(len=*), intent(in) :: msg
-      call add_problem(deck, line_no, msg)
-    end subroutine report
   end subroutine scan_groups
 
   subroutine read_run(u, deck, line)

@@ -56,16 +56,13 @@ contains
   end function key_type
 
   !> Check the group whose '&name' is on line first of text(:). Each problem is returned as
-  !> (line, message) through report.
-  subroutine lint_group(text, first, group, report)
+  !> a line number and a message (returned, not reported through a callback: an internal
+  !> procedure passed as an argument would need a trampoline on an executable stack).
+  subroutine lint_group(text, first, group, lines, msgs)
     character(len=*), intent(in) :: text(:), group
     integer, intent(in) :: first
-    interface
-      subroutine report(line, msg)
-        integer, intent(in) :: line
-        character(len=*), intent(in) :: msg
-      end subroutine report
-    end interface
+    integer, allocatable, intent(out) :: lines(:)
+    character(len=512), allocatable, intent(out) :: msgs(:)
     character(len=:), allocatable :: s, key, item
     integer, allocatable :: lineof(:)
     integer :: i, j, k, n, p
@@ -73,6 +70,7 @@ contains
     logical :: done
 
     ! the group as one string (comments cut), with the line of each character
+    allocate (lines(0), msgs(0))
     s = ''
     allocate (lineof(0))
     do i = first, size(text)
@@ -162,6 +160,13 @@ contains
       end select
       if (ios /= 0) call report(line, '&'//group//': '//key//' = '//w//' is not '//kind_name(t))
     end subroutine value
+
+    subroutine report(line, msg)
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: msg
+      lines = [lines, line]
+      msgs = [character(len=512) :: msgs, msg]
+    end subroutine report
   end subroutine lint_group
 
   pure function kind_name(t) result(s)
