@@ -8,7 +8,7 @@
 !> factorises and solves its own block: the solves, which dominate a long run, then need no
 !> communication at all. Two equal bodies on two ranks solve twice as fast, where one MUMPS
 !> instance over both ranks solves 1.5x as fast. Bodies left over when they do not deal evenly
-!> (the third of three spheres on two ranks) form a second block shared by all ranks, with a
+!> (one of three spheres on two ranks) form a second block shared by all ranks, with a
 !> MUMPS instance of its own; bodies that share out neither way stay in one instance
 !> (docs/performance.md).
 module casca_assembly
