@@ -8,7 +8,7 @@ import os
 import sys
 
 from paraview.simple import (Calculator, ColorBy, GetActiveViewOrCreate, GetColorTransferFunction,
-                             PVDReader, Render, ResetCamera, SaveScreenshot, Show, Text,
+                             GetScalarBar, PVDReader, Render, ResetCamera, SaveScreenshot, Show, Text,
                              UpdatePipeline)
 
 folder = sys.argv[1]
@@ -25,7 +25,11 @@ ColorBy(display, ("POINTS", "speed"))
 lut = GetColorTransferFunction("speed")
 lut.ApplyPreset("Viridis (matplotlib)", True)
 display.SetScalarBarVisibility(view, True)
-bar = lut.GetScalarBar(view) if hasattr(lut, "GetScalarBar") else None
+bar = GetScalarBar(lut, view)
+bar.Title = "speed [m/s]"
+bar.ComponentTitle = ""
+bar.TitleColor = [0, 0, 0]   # the default white is lost on the white background
+bar.LabelColor = [0, 0, 0]
 label = Text()
 label_display = Show(label, view)
 label_display.Color = [0, 0, 0]

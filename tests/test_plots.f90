@@ -8,8 +8,9 @@ program test_plots
   use casca_plots, only: make_plots
   implicit none
 
-  character(len=*), parameter :: pngs(7) = [character(len=16) :: 'positions_x.png', &
-    'positions_y.png', 'positions_z.png', 'energy.png', 'momentum.png', 'contact.png', 'newton.png']
+  character(len=*), parameter :: pngs(8) = [character(len=17) :: 'positions_x.png', &
+    'positions_y.png', 'positions_z.png', 'displacements.png', 'energy.png', 'momentum.png', &
+    'contact.png', 'newton.png']
   integer :: npass = 0, nfail = 0
   character(len=:), allocatable :: root, d
   type(error_t), allocatable :: err

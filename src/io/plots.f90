@@ -271,6 +271,26 @@ contains
         end do
         s = s//nl//nl
       end do
+      ! Displacements show what positions metres apart hide (the spheres move by millimetres);
+      ! each curve is taken from its own first row (gnuplot reads the curves one by one).
+      s = s//'# x, y, z displacement of every tracked node from its first row'//nl// &
+          'set terminal @term size 1000,1100'//nl// &
+          "set output 'displacements.png'"//nl// &
+          "set multiplot layout 3,1 title 'Displacement of the tracked nodes vs time' font ',15'"//nl
+      do a = 1, 3
+        s = s//"set title '"//axis(a)//"'"//nl//"set ylabel 'u_"//axis(a)//" [m]'"//nl
+        if (a == 3) s = s//'set key below horizontal spacing 1.2 width 2'//nl
+        if (a < 3) s = s//'unset key'//nl
+        s = s//'plot '
+        do k = 1, nk
+          v = 'c_p'//itoa(k)//'_'//axis(a)
+          if (k > 1) s = s//', \'//nl//'     '
+          s = s//"datafile using (ms(c_t)):($0 == 0 ? (u0 = column("//v//"), 0) : column("//v// &
+              ") - u0) with lines lt "//itoa(k)//" title '"//gp_quote(labels(k)%s)//"'"
+        end do
+        s = s//nl
+      end do
+      s = s//'unset multiplot'//nl//'set terminal @term size 1000,600'//nl//nl
     else
       s = s//'# No tracked nodes in history.dat: no position plots.'//nl//nl
     end if
