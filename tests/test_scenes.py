@@ -11,6 +11,8 @@ usage: test_scenes.py CASCA EXAMPLES_DIR WORK_DIR [--quick]
               they are within reach no body is solved; sphere 3 stays exactly where it was;
               the mesh is mirror-symmetric about y = 0 and z = 0, so the touching poles stay
               on the x axis (with the thesis' element normals they slide off it, sideways)
+  two_spheres: head-on, contact duration and peak force against Reissner's point-load
+              stiffness of a spherical shell; impulse m v0; momentum; no penetration
 """
 import os
 import sys
@@ -149,4 +151,46 @@ if p.returncode == 0:
               np.max(np.hypot(h["p%d_y" % k], h["p%d_z" % k])), 1e-9)
         ck.le("three_spheres: touching pole %d, max sideways speed [m/s]" % k,
               np.max(np.hypot(h["p%d_vy" % k], h["p%d_vz" % k])), 1e-3)
+
+# --- two of the thesis' spheres head-on (320 elements each, dt = 6 us) against Reissner's
+# stiffness of a spherical shell under a point load, k = 4 E h^2 / (sqrt(3 (1 - nu^2)) R):
+# two such springs in series between two masses m = rho 4 pi R^2 h give a contact of
+# pi sqrt((m/2) / (k/2)) = 6.13 ms and a peak force v0 sqrt((k/2) (m/2)) = 1.24e7 N. That model is
+# quasi-static (no shell inertia near the contact), hence the 20% bounds; the 720-element
+# mesh gives 6.89 ms and 1.13e7 N, the 320-element one 6.93 ms and 1.07e7 N. Equal elastic
+# bodies exchange their momentum: the impulse is m v0, less what stays in the shells'
+# vibration (1% bound).
+E, nu, R, thick, rho, v0 = 210e9, 0.3, 1.0, 0.05, 7700.0, 10.0
+msh = os.path.join(work, "sphere_4.msh")
+p = run([casca, "mesh", "sphere", "--radius", "1", "--n-div", "4", "-o", msh])
+ck.record("sphere mesh n_div = 4 made", p.returncode == 0, p.stderr[-300:])
+body = ("&body name = 'sphere%d', mesh = 'file', file = '" + msh + "', center = %g, 0, 0,"
+        " velocity = %g, 0, 0, young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05 /\n")
+deck = os.path.join(work, "two_spheres.nml")
+with open(deck, "w") as f:
+    f.write("&run dt = 6.0e-6, t_end = 8.5e-3 /\n&output vtu = .false., plots = .false. /\n"
+            + body % (1, 0.0, v0) + body % (2, 2.01, 0.0))
+out = os.path.join(work, "two_spheres")
+p = run([casca, "run", deck, "--out", out, "-q"], np_ranks=2)
+ck.record("two spheres (8.5 ms, 2 ranks) run to completion (exit 0)", p.returncode == 0,
+          p.stderr[-300:])
+if p.returncode == 0:
+    h = history(out)
+    m = rho * 4 * np.pi * R**2 * thick
+    k = 4 * E * thick**2 / (np.sqrt(3 * (1 - nu**2)) * R)
+    on = np.nonzero(h["contacts"] > 0)[0]
+    ck.record("two spheres: touch, then part before the end", on.size > 0 and on[-1] < len(h["t"]) - 1)
+    if on.size > 0:
+        duration = h["t"][on[-1]] - h["t"][on[0] - 1]
+        ck.close("two spheres: contact duration vs Reissner's quasi-static shell [s]", duration,
+                 np.pi * np.sqrt(m / k), 0.20)
+        ck.close("two spheres: peak contact force vs Reissner's quasi-static shell [N]",
+                 h["fcontact"].max(), v0 * np.sqrt(m * k / 4), 0.20)
+        ck.close("two spheres: impulse = m v0 (equal elastic bodies exchange momentum) [N s]",
+                 np.sum(0.5 * (h["fcontact"][1:] + h["fcontact"][:-1]) * np.diff(h["t"])),
+                 m * v0, 0.01)
+    p0 = np.array([h["px"][0], h["py"][0], h["pz"][0]])
+    dp = np.max(np.linalg.norm(np.stack([h["px"], h["py"], h["pz"]]).T - p0, axis=1))
+    ck.le("two spheres: linear momentum (max |p - p0| / |p0|)", dp / np.linalg.norm(p0), 1e-8)
+    ck.le("two spheres: deepest penetration [m]", h["penetration"].max(), 1e-6)
 ck.finish()
