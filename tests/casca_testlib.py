@@ -55,6 +55,12 @@ def history(folder):
     return {n: data[:, i] for i, n in enumerate(names)}
 
 
+def momentum_error(h):
+    """Largest change of the total linear momentum over the run, relative to the initial."""
+    p = np.stack([h["px"], h["py"], h["pz"]]).T
+    return np.max(np.linalg.norm(p - p[0], axis=1)) / np.linalg.norm(p[0])
+
+
 def deck_variant(src, dst, **changes):
     """Copy a deck, replacing `key = value` assignments (first occurrence of each key) and
     making relative mesh paths absolute so the copy can live elsewhere."""

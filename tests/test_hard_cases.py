@@ -7,7 +7,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, run
+from casca_testlib import Checks, history, momentum_error, run
 
 casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
 os.makedirs(work, exist_ok=True)
@@ -32,11 +32,6 @@ def rings(name, v=10.0, dt=5e-5, t_end=0.03, center="2.01, 0.0, 0.0", thickness=
     p = run([casca, "run", deck, "--out", out, "-q"])
     ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
     return history(out) if p.returncode == 0 else None
-
-
-def momentum_error(h):
-    p = np.stack([h["px"], h["py"], h["pz"]]).T
-    return np.max(np.linalg.norm(p - p[0], axis=1)) / np.linalg.norm(p[0])
 
 
 def common(name, h, touch=True):
