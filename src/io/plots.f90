@@ -271,7 +271,7 @@ contains
         end do
         s = s//nl//nl
       end do
-      ! Displacements show what positions metres apart hide (the spheres move by millimetres);
+      ! Displacements show what positions metres apart hide (the spheres move by centimetres);
       ! each curve is taken from its own first row (gnuplot reads the curves one by one).
       s = s//'# x, y, z displacement of every tracked node from its first row'//nl// &
           'set terminal @term size 1000,1100'//nl// &
