@@ -153,15 +153,15 @@ if p.returncode == 0:
 # two such springs in series between two masses m = rho 4 pi R^2 h give a contact of
 # pi sqrt((m/2) / (k/2)) = 6.13 ms and a peak force v0 sqrt((k/2) (m/2)) = 1.24e7 N. That model is
 # quasi-static (no shell inertia near the contact), hence the 20% bounds; the 720-element
-# mesh gives 6.89 ms and 1.13e7 N, the 320-element one 6.93 ms and 1.07e7 N. Equal elastic
+# mesh gives 6.89 ms and 1.13e7 N, the 320-element one 6.94 ms and 1.07e7 N. Equal elastic
 # bodies exchange their momentum: the impulse is m v0, less what stays in the shells'
 # vibration (1% bound).
 E, nu, R, thick, rho, v0 = 210e9, 0.3, 1.0, 0.05, 7700.0, 10.0
 msh = os.path.join(work, "sphere_4.msh")
 p = run([casca, "mesh", "sphere", "--radius", "1", "--n-div", "4", "-o", msh])
 ck.record("sphere mesh n_div = 4 made", p.returncode == 0, p.stderr[-300:])
-body = ("&body name = 'sphere%d', mesh = 'file', file = '" + msh + "', center = %g, 0, 0,"
-        " velocity = %g, 0, 0, young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05 /\n")
+body = ("&body name = 'sphere%%d', mesh = 'file', file = '%s', center = %%g, 0, 0, velocity = %%g, 0, 0,"
+        " young = %g, poisson = %g, density = %g, thickness = %g /\n" % (msh, E, nu, rho, thick))
 deck = os.path.join(work, "two_spheres.nml")
 with open(deck, "w") as f:
     f.write("&run dt = 6.0e-6, t_end = 8.5e-3 /\n&output vtu = .false., plots = .false. /\n"
