@@ -40,22 +40,12 @@ module casca_contact
     integer :: nact = 0
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
-    integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
     real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
-    logical :: schur = .true.                   !< solve through the Schur complement of K
     logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
     ! the target elements at node n: node_elem(node_start(n) : node_start(n+1) - 1), and which
     ! of their nodes n is (node_loc); shape derivatives at the 10 nodes (dphi_node)
     integer, allocatable :: node_start(:), node_elem(:), node_loc(:)
     real(dp) :: dphi_node(10, 2, 10) = 0
-    ! Schur cache: Z = K^-1 C^T (block hosts, their rows) and S = C Z (LU, every rank) for
-    ! the constraints (z_node, z_elem) and their rows (z_irn, z_jcn, z_val), made with the
-    ! factors of K in use while z_current
-    real(dp), allocatable :: z(:, :), s(:, :)
-    integer, allocatable :: z_irn(:), z_jcn(:), z_ipiv(:), z_node(:), z_elem(:)
-    real(dp), allocatable :: z_val(:)
-    logical :: z_current = .false.
-    integer :: z_positive = 0                   !< positive eigenvalues of S
   end type contact_t
 
 contains

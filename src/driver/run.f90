@@ -7,8 +7,8 @@ module casca_run
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs
   use casca_model, only: model_t, reference_state, dof
-  use casca_assembly, only: assembly_t, assembly_setup, nblocks
-  use casca_mumps_solver, only: sparse_solver_t
+  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
   use casca_accounting, only: balance_t, account, gravity_load
@@ -83,7 +83,7 @@ contains
     type(deck_t) :: deck
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver(nblocks)   !< one per block of K (casca_assembly)
+    type(linear_system_t) :: ls
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
@@ -112,7 +112,7 @@ contains
     call setup_contact()
     call assembly_setup(model, asm, err, split=split_bodies())
     if (failed('setup')) return
-    if (deck%run%ordering == 'metis') solver%ordering = 1
+    if (deck%run%ordering == 'metis') ls%solver%ordering = 1
     opts%tol = deck%run%newton_tol; opts%max_iter = deck%run%newton_max_iter
     opts%reuse = deck%run%reuse_factorisation
     allocate (fgrav(model%ndof))
@@ -196,9 +196,9 @@ contains
       end if
       q_before = st%q; qd_before = st%qd
       if (use_contact) then
-        call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
+        call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
       else
-        call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err)
+        call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err)
       end if
       if (allocated(err)) then
         if (level < deck%run%max_step_cuts) then
@@ -259,9 +259,7 @@ contains
       if (all(fz .eqv. frozen)) return
       frozen = fz
       call assembly_setup(model, asm, err, frozen, split_bodies())
-      do b = 1, nblocks
-        call solver(b)%new_pattern()
-      end do
+      call ls%new_pattern()
     end subroutine update_frozen
 
     !> The ranks that factorise and solve body b's block (when every body is solved)
@@ -285,17 +283,16 @@ contains
 
     !> K is block diagonal by body unless the constraints are factorised with it ('saddle')
     logical function split_bodies()
-      split_bodies = .true.
-      if (use_contact) split_bodies = contact%schur
+      split_bodies = ls%schur
     end function split_bodies
 
     subroutine setup_contact()
       integer, allocatable :: pairs(:, :)
       allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
       use_contact = size(pairs, 2) > 0
+      ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
       if (use_contact) then
         call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
-        contact%schur = deck%contact%solver == 'schur'
         contact%nodal_normal = deck%contact%normal == 'nodal'
       end if
     end subroutine setup_contact
@@ -347,10 +344,7 @@ contains
 
     subroutine checkpoint()
       type(error_t), allocatable :: e
-      integer :: s
-      do s = 1, nblocks   ! on every rank: a restart from here starts with new factors
-        call solver(s)%drop_factors()
-      end do
+      call ls%drop_factors()   ! on every rank: a restart from here starts with new factors
       if (.not. is_root()) return
       if (use_contact) then
         call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, &
@@ -407,11 +401,11 @@ contains
       integer :: i
       do i = 1, deck%run%load_steps
         if (use_contact) then
-          call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
-                            opts, st%q, rep, err, contact)
+          call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
+                            deck%run%max_step_cuts, opts, st%q, rep, err, contact)
         else
-          call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
-                            opts, st%q, rep, err)
+          call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
+                            deck%run%max_step_cuts, opts, st%q, rep, err)
         end if
         if (allocated(err)) then
           call give_up(err%message); return
