@@ -164,8 +164,12 @@ contains
         if (is_active(n, ip)) cycle
         call project(n, ip, cn, sd, found)
         if (.not. found) cycle
-        if (sd < -c%tol .and. has_free_position(n, cn%elem)) then
-          call finish(cn)
+        ! the sub-triangles are chords of the cubic surface, up to depth away from it: they
+        ! find the candidates, the constraint's own gap decides (else a node released with
+        ! zero gap would be taken again at once where the chord lies outside the surface)
+        if (sd >= c%depth(c%pair(2, ip)) .or. .not. has_free_position(n, cn%elem)) cycle
+        call finish(cn)
+        if (cn%gap < -c%tol) then
           call push(cn)
           added = added + 1
         end if
@@ -379,7 +383,7 @@ contains
     do k = 1, probe%nact
       if (any(c%act(1:c%nact)%node == probe%act(k)%node .and. &
               c%act(1:c%nact)%pair == probe%act(k)%pair)) cycle
-      free_pen = max(free_pen, -probe%act(k)%sd)
+      free_pen = max(free_pen, -probe%act(k)%gap)
     end do
     max_gap = 0
     if (c%nact > 0) max_gap = maxval(abs(c%act(1:c%nact)%gap))
@@ -413,10 +417,12 @@ contains
     real(dp), intent(in) :: tol
     type(contact_t), intent(out) :: probe
     probe%npairs = c%npairs; probe%pair = c%pair; probe%surf = c%surf; probe%depth = c%depth
+    probe%node_start = c%node_start; probe%node_elem = c%node_elem; probe%node_loc = c%node_loc
+    probe%dphi_node = c%dphi_node
     allocate (probe%grid(c%npairs), probe%grid_ok(c%npairs), probe%act(16))
     probe%grid_ok = .false.
     probe%tol = tol
-    probe%nodal_normal = .false.   ! the probes read signed distances only
+    probe%nodal_normal = c%nodal_normal   ! the gaps as the constraints measure them
   end subroutine new_probe
 
   !> Total normal contact force (sum of the compressive multipliers).

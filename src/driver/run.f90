@@ -65,12 +65,12 @@ contains
       call reference_state(model, q)
       call contact_update(probe, model, q, .true., added)
       if (added == 0) return
-      worst = minloc(probe%act(1:probe%nact)%sd, dim=1)
+      worst = minloc(probe%act(1:probe%nact)%gap, dim=1)
       k = probe%act(worst)%node
       write (msg, '(a,a,a,a,a,i0,a,es10.3,a,i0,a)') 'bodies ''', &
         trim(model%body(model%node_body(k))%name), ''' and ''', &
         trim(model%body(pairs(2, probe%act(worst)%pair))%name), ''' overlap at the start: node ', &
-        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%sd, &
+        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, &
         ' m inside (', added, ' nodes in all); move them apart'
       call add_problem(deck, 0, trim(msg))
     end subroutine check_overlap
