@@ -20,7 +20,6 @@ module casca_contact
   private
   public :: contact_t, constraint_t, contact_init, contact_update, contact_release, contact_rows
   public :: contact_penetration, contact_force_total, contact_nodal_fields, contact_signed_distance
-  public :: contact_persistency
 
   type :: constraint_t
     integer :: node = 0, pair = 0, elem = 0
@@ -40,7 +39,6 @@ module casca_contact
     integer :: nact = 0
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
-    real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
     logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
     ! the target elements at node n: node_elem(node_start(n) : node_start(n+1) - 1), and which
     ! of their nodes n is (node_loc); shape derivatives at the 10 nodes (dphi_node)
@@ -65,14 +63,6 @@ contains
     allocate (c%surf(model%nbody), c%grid(c%npairs), c%grid_ok(c%npairs), &
               c%depth(model%nbody), c%act(16))
     c%grid_ok = .false.; c%depth = 0
-    ! the mass a unit change of a node's velocity adds to the momentum: t^T M e_i
-    allocate (c%node_mass(model%nnode))
-    c%node_mass = 0
-    do e = 1, model%nelem
-      do k = 1, 10
-        c%node_mass(model%conn(k, e)) = c%node_mass(model%conn(k, e)) + sum(model%emass(1:10, k, e))
-      end do
-    end do
     do b = 1, model%nbody
       if (.not. any(pairs(2, :) == b)) cycle
       associate (bd => model%body(b))
@@ -324,48 +314,6 @@ contains
       m = m + 1; irn(m) = i; jcn(m) = j2; val(m) = v
     end subroutine put
   end subroutine contact_rows
-
-  !> Persistent contact after a converged step (Taylor & Papadopoulos 1993): the normal
-  !> relative velocity and acceleration of each constraint are removed by an impulse on the
-  !> impactor node and the opposite impulse spread over the target nodes by N_j, so that the
-  !> momentum t^T M v stays exactly as it was. Without it the trapezoidal rule turns the
-  !> position constraint into a velocity that flips sign every step, and gains energy.
-  subroutine contact_persistency(c, model, qd, qdd)
-    type(contact_t), intent(in) :: c
-    type(model_t), intent(in) :: model
-    real(dp), intent(inout) :: qd(:), qdd(:)
-    integer :: k
-    do k = 1, c%nact
-      call remove_normal(qd, c%act(k))
-      call remove_normal(qdd, c%act(k))
-    end do
-  contains
-    subroutine remove_normal(v, a)
-      real(dp), intent(inout) :: v(:)
-      type(constraint_t), intent(in) :: a
-      real(dp) :: w, flex, p
-      integer :: j, nd
-      logical :: free_i
-      free_i = .not. any(model%fixed(dof(a%node, 1):dof(a%node, 3)))
-      w = dot_product(v(dof(a%node, 1):dof(a%node, 3)), a%n)
-      flex = 0
-      if (free_i) flex = 1/c%node_mass(a%node)
-      do j = 1, 10
-        nd = model%conn(j, a%elem)
-        w = w - a%shp(j)*dot_product(v(dof(nd, 1):dof(nd, 3)), a%n)
-        if (.not. any(model%fixed(dof(nd, 1):dof(nd, 3)))) flex = flex + a%shp(j)**2/c%node_mass(nd)
-      end do
-      if (flex <= 0) return
-      p = -w/flex
-      if (free_i) v(dof(a%node, 1):dof(a%node, 3)) = v(dof(a%node, 1):dof(a%node, 3)) &
-                                                       + (p/c%node_mass(a%node))*a%n
-      do j = 1, 10
-        nd = model%conn(j, a%elem)
-        if (any(model%fixed(dof(nd, 1):dof(nd, 3)))) cycle
-        v(dof(nd, 1):dof(nd, 3)) = v(dof(nd, 1):dof(nd, 3)) - (p*a%shp(j)/c%node_mass(nd))*a%n
-      end do
-    end subroutine remove_normal
-  end subroutine contact_persistency
 
   !> Deepest penetration of the impactor nodes that carry no constraint (signed distance to
   !> the sub-triangles) and largest |gap| of those that do.

@@ -9,6 +9,7 @@ module casca_run
   use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
+  use casca_mass_solver, only: mass_setup
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
   use casca_accounting, only: balance_t, account, gravity_load
@@ -110,6 +111,7 @@ contains
     if (out_dir /= '') dir = trim(out_dir)
 
     call setup_contact()
+    if (failed('setup')) return
     call assembly_setup(model, asm, err, split=split_bodies())
     if (failed('setup')) return
     if (deck%run%ordering == 'metis') ls%solver%ordering = 1
@@ -293,19 +295,22 @@ contains
       ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
       if (use_contact) then
         call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
+        if (deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
         contact%nodal_normal = deck%contact%normal == 'nodal'
       end if
     end subroutine setup_contact
 
     subroutine history_row(newton)
       integer, intent(in) :: newton
-      pen = 0; gmax = 0
+      real(dp) :: lmax
+      pen = 0; gmax = 0; lmax = 0
       if (use_contact) then
         call contact_penetration(contact, model, st%q, pen, gmax)
+        if (contact%nact > 0) lmax = maxval(contact%act(1:contact%nact)%lambda)
         call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
-                            max(pen, 0._dp), rep%neg_pivots, err)
+                            max(pen, 0._dp), rep%neg_pivots, lmax, gmax, err)
       else
-        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, err)
+        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, 0._dp, 0._dp, err)
       end if
     end subroutine history_row
 

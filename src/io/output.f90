@@ -39,7 +39,8 @@ contains
     character(len=8) :: p
     integer :: k, c
     cols = [character(len=16) :: 't', 'step', 'kinetic', 'strain', 'work', 'total', 'px', 'py', &
-            'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton', 'penetration', 'neg_pivots']
+            'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton', 'penetration', 'neg_pivots', &
+            'lambda_max', 'gap_max']
     do k = 1, ntrack
       write (p, '(a,i0)') 'p', k
       do c = 1, 6
@@ -159,19 +160,23 @@ contains
 
   !> One row: time, energies, momenta, contacts, Newton iterations, deepest penetration of a
   !> node without constraint, negative pivots of the last factorisation (the inertia of the
-  !> saddle-point matrix: one per active constraint), tracked nodes.
-  subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, err)
+  !> saddle-point matrix: one per active constraint), the most tensile multiplier and the
+  !> largest |gap| of the active constraints (the contact conditions at the accepted step),
+  !> tracked nodes.
+  subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, &
+                            lambda_max, gap_max, err)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
     integer, intent(in) :: contacts, newton, neg_pivots
-    real(dp), intent(in) :: fcontact, penetration
+    real(dp), intent(in) :: fcontact, penetration, lambda_max, gap_max
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: row(:)
     integer :: k, n
     if (.not. is_root()) return
     row = [st%t, real(st%step, dp), bal%kinetic, bal%strain, bal%work, bal%total, bal%p, bal%l, &
-           real(contacts, dp), fcontact, real(newton, dp), penetration, real(neg_pivots, dp)]
+           real(contacts, dp), fcontact, real(newton, dp), penetration, real(neg_pivots, dp), &
+           lambda_max, gap_max]
     do k = 1, size(out%tracked)
       n = out%tracked(k)
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]

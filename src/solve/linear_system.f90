@@ -13,6 +13,7 @@ module casca_linear_system
   use casca_assembly, only: assembly_t, nblocks
   use casca_mumps_solver, only: sparse_solver_t
   use casca_schur, only: schur_t, schur_valid, schur_store, schur_apply
+  use casca_mass_solver, only: mass_solver_t
   use casca_metis, only: nested_dissection
   use casca_mpi, only: sum_all, share_error
   implicit none
@@ -33,6 +34,7 @@ module casca_linear_system
     logical :: schur = .true.                  !< constraints through the Schur complement
     type(schur_t) :: cache                     !< Z and S of the Schur path
     integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
+    type(mass_solver_t) :: mass                !< M by component, for the contact correction
   contains
     procedure :: finish => system_finish
     procedure :: drop_factors => system_drop_factors
@@ -199,6 +201,7 @@ contains
     do s = 1, nblocks
       call self%solver(s)%finish()
     end do
+    call self%mass%finish()
   end subroutine system_finish
 
   !> The next solve refactorises (a restart from a checkpoint takes the same path).

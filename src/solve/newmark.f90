@@ -7,7 +7,8 @@ module casca_newmark
   use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t, contact_persistency
+  use casca_contact, only: contact_t
+  use casca_contact_correction, only: contact_correction
   implicit none
   private
   public :: state_t, newmark_t, newmark_step, static_solve
@@ -38,11 +39,11 @@ contains
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: qs(:), rs(:), q(:)
+    real(dp), allocatable :: qs(:), rs(:), q(:), qd(:), qdd(:)
     real(dp) :: b, dt, g
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
-    allocate (qs, rs, q, mold=st%q)   ! (not on assignment: gfortran warns, falsely)
+    allocate (qs, rs, q, qd, qdd, mold=st%q)   ! (not on assignment: gfortran warns, falsely)
     qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*st%qdd
     rs = st%qd + dt*(1 - g)*st%qdd
     ! predictor: the step taken with zero new acceleration
@@ -52,13 +53,16 @@ contains
     if (.not. allocated(err) .and. .not. rep%converged) &
       call fatal_error(err, 'Newton did not converge')
     if (allocated(err)) return
-    st%q = q
-    st%qdd = q/(b*dt*dt) - qs
-    st%qd = rs + g*dt*st%qdd
-    if (present(contact)) call contact_persistency(contact, model, st%qd, st%qdd)
+    qdd = q/(b*dt*dt) - qs
+    qd = rs + g*dt*qdd
+    if (present(contact)) then   ! (on failure the state is left as it was)
+      call contact_correction(ls%mass, contact, model, qd, qdd, err)
+      if (allocated(err)) return
+    end if
     where (model%fixed)
-      st%qd = 0; st%qdd = 0
+      qd = 0; qdd = 0
     end where
+    st%q = q; st%qd = qd; st%qdd = qdd
     st%t = st%t + dt
     st%step = st%step + 1
   end subroutine newmark_step

@@ -1,0 +1,133 @@
+!> The velocity after a converged step with contact (persistency, Taylor & Papadopoulos
+!> 1993; Laursen & Love 2002 with no restitution), as a projection in the metric of the
+!> consistent mass M:
+!>     v+ = v + M^-1 C^T nu,   S nu = -C v,   S = C M^-1 C^T,
+!> and likewise C a+ = 0 for the acceleration, over every active constraint: each has a
+!> compressive multiplier at the end of the step, so it is in contact there, and a contact
+!> that opens does so in a later step through its multiplier, never by a velocity it keeps.
+!> Without the acceleration's projection a released constraint's force would go on acting
+!> through the next step's start acceleration: the trapezoidal rule gains 1/2 p g at every
+!> release (two rings: +15% of the energy; with it the energy never rises). The change of
+!> momentum is then M (v+ - v) = C^T nu: equal and opposite impulses along n at the two
+!> sides of each contact, so the linear and the angular momentum of the free bodies are
+!> kept exactly (with a lumped mass only the linear one is), and the kinetic energy drops
+!> by 1/2 (C v)^T S^-1 (C v) >= 0: a correction that never adds energy.
+module casca_contact_correction
+  use casca_kinds, only: dp
+  use casca_error, only: error_t, fatal_error
+  use casca_model, only: model_t, dof
+  use casca_contact, only: contact_t
+  use casca_mass_solver, only: mass_solver_t
+  use casca_lapack, only: dpotrf, dpotrs
+  implicit none
+  private
+  public :: contact_correction
+
+contains
+
+  !> Project v and a (full-length, every rank alike) onto the active constraints' persistent
+  !> contact: C v+ = 0, C a+ = 0.
+  subroutine contact_correction(ms, c, model, v, a, err)
+    type(mass_solver_t), intent(inout) :: ms
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(inout) :: v(:), a(:)
+    type(error_t), allocatable, intent(out) :: err
+    real(dp), allocatable :: s(:, :), nu(:, :)
+    integer :: nc, k, info
+    nc = c%nact
+    if (nc == 0) return
+    allocate (s(nc, nc), nu(nc, 2))
+    call schur(err)   ! S = sum over components of B^T M^-1 B, B = C^T of the component
+    if (allocated(err)) return
+    nu(:, 1) = -[(row_dot(k, v), k=1, nc)]
+    nu(:, 2) = -[(row_dot(k, a), k=1, nc)]
+    call dpotrf('L', nc, s, nc, info)
+    if (info /= 0) then
+      call fatal_error(err, 'contact correction: dependent constraints (C M^-1 C^T is singular)')
+      return
+    end if
+    call dpotrs('L', nc, 2, s, nc, nu, nc, info)
+    call apply(nu(:, 1), v, err)
+    if (allocated(err)) return
+    call apply(nu(:, 2), a, err)
+  contains
+    !> B (equations of component comp, nc): the rows of C on that component, as columns
+    subroutine columns(comp, b)
+      integer, intent(in) :: comp
+      real(dp), intent(out) :: b(:, :)
+      integer :: col, j, d(11)
+      real(dp) :: val(11)
+      b = 0
+      do col = 1, nc
+        associate (con => c%act(col))
+          d(1) = dof(con%node, comp); val(1) = con%n(comp)
+          d(2:) = dof(model%conn(:, con%elem), comp); val(2:) = -con%shp*con%n(comp)
+        end associate
+        do j = 1, 11
+          if (ms%eq(d(j)) > 0) b(ms%eq(d(j)), col) = b(ms%eq(d(j)), col) + val(j)
+        end do
+      end do
+    end subroutine columns
+
+    subroutine schur(e)
+      type(error_t), allocatable, intent(out) :: e
+      real(dp), allocatable :: b(:, :), x(:, :)
+      integer :: comp
+      s = 0
+      do comp = 1, 3
+        if (ms%neq(comp) == 0) cycle
+        allocate (b(ms%neq(comp), nc), x(ms%neq(comp), nc))
+        call columns(comp, b)
+        call ms%solve(comp, b, x, e)
+        if (allocated(e)) return
+        s = s + matmul(transpose(b), x)
+        deallocate (b, x)
+      end do
+      s = 0.5_dp*(s + transpose(s))
+    end subroutine schur
+
+    !> y = y + M^-1 C^T x, the impulse x along the constraints
+    subroutine apply(x, y, e)
+      real(dp), intent(in) :: x(:)
+      real(dp), intent(inout) :: y(:)
+      type(error_t), allocatable, intent(out) :: e
+      real(dp), allocatable :: b(:, :), z(:, :)
+      integer :: comp, i
+      do comp = 1, 3
+        if (ms%neq(comp) == 0) cycle
+        allocate (b(ms%neq(comp), nc), z(ms%neq(comp), 1))
+        call columns(comp, b)
+        call ms%solve(comp, matmul(b, reshape(x, [nc, 1])), z, e)
+        if (allocated(e)) return
+        do i = 1, model%ndof
+          if (ms%eq(i) > 0 .and. is_comp(i, comp)) y(i) = y(i) + z(ms%eq(i), 1)
+        end do
+        deallocate (b, z)
+      end do
+    end subroutine apply
+
+    pure logical function is_comp(i, comp)
+      integer, intent(in) :: i, comp
+      integer :: r
+      r = mod(i - 1, 7) + 1
+      is_comp = r == comp .or. r == comp + 3
+    end function is_comp
+
+    !> row k of C times y: the normal relative rate of constraint k
+    real(dp) function row_dot(k, y)
+      integer, intent(in) :: k
+      real(dp), intent(in) :: y(:)
+      integer :: j
+      associate (con => c%act(k))
+        row_dot = dot_product(con%n, y(dof(con%node, 1):dof(con%node, 3)))
+        do j = 1, 10
+          row_dot = row_dot - con%shp(j)*dot_product(con%n, &
+                    y(dof(model%conn(j, con%elem), 1):dof(model%conn(j, con%elem), 3)))
+        end do
+      end associate
+    end function row_dot
+
+  end subroutine contact_correction
+
+end module casca_contact_correction

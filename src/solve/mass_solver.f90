@@ -1,0 +1,103 @@
+!> The consistent mass M = m (x) I3 over the vector parameters (Y, G) of every node: each
+!> component x, y, z is a sparse symmetric positive definite system of its own (restrained
+!> parameters left out; A carries no mass), factorised once per run by MUMPS on each rank
+!> alone, for the contact correction, which is replicated like the contact itself.
+module casca_mass_solver
+  use casca_kinds, only: dp
+  use casca_error, only: error_t
+  use casca_model, only: model_t, dof
+  use casca_mumps_solver, only: sparse_solver_t
+  use casca_mpi, only: n_ranks
+  implicit none
+  private
+  public :: mass_solver_t, mass_setup
+
+  type :: mass_solver_t
+    type(sparse_solver_t) :: m(3)        !< the scalar mass of component c's free parameters
+    integer, allocatable :: eq(:)        !< (ndof) equation of each Y, G parameter in its
+                                         !< component's system; 0 restrained, or A
+    integer :: neq(3) = 0
+    integer :: solver_of(3) = [1, 2, 3]  !< components with the same restraints share one
+  contains
+    procedure :: solve => mass_solve
+    procedure :: finish => mass_finish
+  end type mass_solver_t
+
+contains
+
+  !> Number, assemble and factorise the three component systems.
+  subroutine mass_setup(model, ms, err)
+    type(model_t), intent(in) :: model
+    type(mass_solver_t), intent(inout) :: ms
+    type(error_t), allocatable, intent(out) :: err
+    integer, allocatable :: irn(:), jcn(:), noperm(:)
+    real(dp), allocatable :: a(:)
+    integer :: c, c2, n, e, p, qq, k, ip, iq
+    allocate (ms%eq(model%ndof), noperm(0))
+    ms%eq = 0
+    do c = 1, 3
+      k = 0
+      do n = 1, model%nnode
+        do p = 0, 1   ! Y, then G
+          if (model%fixed(dof(n, c + 3*p))) cycle
+          k = k + 1; ms%eq(dof(n, c + 3*p)) = k
+        end do
+      end do
+      ms%neq(c) = k
+    end do
+    do c = 2, 3   ! same restraints as an earlier component: same matrix
+      do c2 = 1, c - 1
+        if (all(model%fixed(dof([(n, n=1, model%nnode)], c)) .eqv. model%fixed(dof([(n, n=1, model%nnode)], c2))) .and. &
+            all(model%fixed(dof([(n, n=1, model%nnode)], c + 3)) .eqv. &
+                model%fixed(dof([(n, n=1, model%nnode)], c2 + 3)))) then
+          ms%solver_of(c) = ms%solver_of(c2); exit
+        end if
+      end do
+    end do
+    do c = 1, 3
+      if (ms%solver_of(c) /= c .or. ms%neq(c) == 0) cycle
+      allocate (irn(210*model%nelem), jcn(210*model%nelem), a(210*model%nelem))
+      k = 0
+      do e = 1, model%nelem
+        do qq = 1, 20
+          iq = ms%eq(param_dof(e, qq, c))
+          if (iq == 0) cycle
+          do p = 1, 20
+            ip = ms%eq(param_dof(e, p, c))
+            if (ip < iq) cycle   ! lower triangle
+            k = k + 1; irn(k) = ip; jcn(k) = iq; a(k) = model%emass(p, qq, e)
+          end do
+        end do
+      end do
+      ! each rank alone: the correction is replicated like the contact
+      call ms%m(c)%analyse(ms%neq(c), irn(1:k), jcn(1:k), noperm, err, n_ranks)
+      if (.not. allocated(err)) call ms%m(c)%factorise(a(1:k), err)
+      deallocate (irn, jcn, a)
+      if (allocated(err)) return
+    end do
+  contains
+    !> the dof of component c of vector parameter p (1..10 Y, 11..20 G) of element e
+    pure integer function param_dof(e, p, c)
+      integer, intent(in) :: e, p, c
+      param_dof = dof(model%conn(1 + mod(p - 1, 10), e), c + 3*((p - 1)/10))
+    end function param_dof
+  end subroutine mass_setup
+
+  !> x = m^-1 b for component comp (b, x: (neq(comp), nrhs))
+  subroutine mass_solve(self, comp, b, x, err)
+    class(mass_solver_t), intent(inout) :: self
+    integer, intent(in) :: comp
+    real(dp), intent(in) :: b(:, :)
+    real(dp), intent(out) :: x(:, :)
+    type(error_t), allocatable, intent(out) :: err
+    call self%m(self%solver_of(comp))%solve(b, x, err)
+  end subroutine mass_solve
+
+  subroutine mass_finish(self)
+    class(mass_solver_t), intent(inout) :: self
+    integer :: c
+    do c = 1, 3
+      call self%m(c)%finish()
+    end do
+  end subroutine mass_finish
+end module casca_mass_solver
