@@ -1,10 +1,11 @@
 !> Replacing a file atomically: write NAME.part, then rename it onto NAME, so that a reader
-!> never sees a half-written result. Fortran 2008 has no rename, so the C library's is used.
+!> never sees a half-written result; making folders. Fortran 2008 has neither rename nor mkdir,
+!> so the C library's are used (never a shell: a name is then only a name).
 module casca_files
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
   implicit none
   private
-  public :: rename_file, delete_file
+  public :: rename_file, delete_file, make_dir, is_dir
 
   interface
     function c_rename(old, new) bind(c, name='rename') result(stat)
@@ -12,6 +13,13 @@ module casca_files
       character(kind=c_char), intent(in) :: old(*), new(*)
       integer(c_int) :: stat
     end function c_rename
+
+    function c_mkdir(path, mode) bind(c, name='mkdir') result(stat)
+      import :: c_char, c_int
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int), value :: mode   ! mode_t: unsigned int on Linux
+      integer(c_int) :: stat
+    end function c_mkdir
   end interface
 
 contains
@@ -21,6 +29,25 @@ contains
     character(len=*), intent(in) :: old, new
     rename_file = c_rename(old//c_null_char, new//c_null_char) == 0
   end function rename_file
+
+  !> Make the folder path and its missing parents (as mkdir -p); .true. when it is a folder now.
+  logical function make_dir(path)
+    character(len=*), intent(in) :: path
+    integer :: i, stat
+    do i = 2, len(path)   ! every parent, from the top: "a/b/c" makes a, a/b, then a/b/c
+      if (path(i:i) == '/' .and. path(i - 1:i - 1) /= '/') then
+        if (.not. is_dir(path(1:i - 1))) stat = c_mkdir(path(1:i - 1)//c_null_char, int(o'777', c_int))
+      end if
+    end do
+    if (.not. is_dir(path)) stat = c_mkdir(path//c_null_char, int(o'777', c_int))
+    make_dir = is_dir(path)
+  end function make_dir
+
+  !> .true. when path names a folder (a file "path/." exists only then)
+  logical function is_dir(path)
+    character(len=*), intent(in) :: path
+    inquire (file=path//'/.', exist=is_dir)
+  end function is_dir
 
   !> Remove a file if it exists (a failed .part).
   subroutine delete_file(path)
