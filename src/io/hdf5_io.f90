@@ -15,7 +15,8 @@
 !> file is flushed to disk only by h5_table_flush (and close).
 !>
 !> Checkpoint layout: scalar datasets "/t" (float64), "/step" and "/ndof" (int32), 1-D
-!> datasets "/q", "/qd", "/qdd" (float64, ndof), "/ints" (int32) and "/reals" (float64), both possibly empty. It is
+!> datasets "/q", "/qd", "/qdd" (float64, ndof), "/ints" (int32) and "/reals" (float64), both possibly empty,
+!> and "/fingerprint" (int32) when the caller gives one (the model's: casca_checkpoint). It is
 !> written to <path>.part and renamed onto <path> only when complete and closed, so a crash
 !> while writing never replaces a good checkpoint (rename(2) is atomic on one file system).
 module casca_hdf5_io
@@ -318,7 +319,7 @@ contains
   !> Write a restart checkpoint to path (via path.part, renamed when complete).
   !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
   !> have any size, including 0.
-  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err)
+  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
@@ -326,6 +327,7 @@ contains
     integer, intent(in) :: ints(:)
     real(dp), intent(in) :: reals(:)
     type(error_t), allocatable, intent(out) :: err
+    integer, intent(in), optional :: fingerprint(:)
 
     character(len=*), parameter :: who = 'write_checkpoint'
     character(len=:), allocatable :: tmp
@@ -355,6 +357,8 @@ contains
     if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'qdd', qdd, err)
     if (.not. allocated(err)) call put_int_1d(who, tmp, fid, 'ints', ints, err)
     if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'reals', reals, err)
+    if (present(fingerprint) .and. .not. allocated(err)) &
+      call put_int_1d(who, tmp, fid, 'fingerprint', fingerprint, err)
     call h5fclose_f(fid, h)
     if (allocated(err)) then
       call delete_file(tmp)
@@ -372,8 +376,8 @@ contains
     end if
   end subroutine write_checkpoint
 
-  !> Read a checkpoint written by write_checkpoint.
-  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err)
+  !> Read a checkpoint written by write_checkpoint (fingerprint: not allocated if it has none).
+  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
@@ -381,10 +385,12 @@ contains
     integer, allocatable, intent(out) :: ints(:)
     real(dp), allocatable, intent(out) :: reals(:)
     type(error_t), allocatable, intent(out) :: err
+    integer, allocatable, intent(out), optional :: fingerprint(:)
 
     character(len=*), parameter :: who = 'read_checkpoint'
     integer(hid_t) :: fid
     integer :: ndof, h
+    logical :: has_fp
 
     t = 0
     step = 0
@@ -398,6 +404,10 @@ contains
     if (.not. allocated(err)) call get_real_1d(who, path, fid, 'qdd', qdd, err)
     if (.not. allocated(err)) call get_int_1d(who, path, fid, 'ints', ints, err)
     if (.not. allocated(err)) call get_real_1d(who, path, fid, 'reals', reals, err)
+    if (present(fingerprint) .and. .not. allocated(err)) then
+      call h5lexists_f(fid, 'fingerprint', has_fp, h)
+      if (h == 0 .and. has_fp) call get_int_1d(who, path, fid, 'fingerprint', fingerprint, err)
+    end if
     call h5fclose_f(fid, h)
     if (allocated(err)) return
     if (size(q) /= ndof .or. size(qd) /= ndof .or. size(qdd) /= ndof) then
@@ -661,10 +671,15 @@ contains
     if (allocated(err)) return
     call dataset_dims(who, path, dset, name, 1, dims, err)
     if (.not. allocated(err)) then
-      allocate (x(dims(1)))
-      h = 0
-      if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, x, dims, h)
-      if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      allocate (x(dims(1)), stat=h)   ! a damaged file may claim any size
+      if (h /= 0) then
+        allocate (x(0))
+        call fatal_error(err, who//': '//path//': /'//name//' claims '//itoa(dims(1))// &
+                         ' values, more than fit in memory')
+      else
+        if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, x, dims, h)
+        if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      end if
     end if
     call h5dclose_f(dset, i)
   end subroutine get_real_1d
@@ -681,10 +696,15 @@ contains
     if (allocated(err)) return
     call dataset_dims(who, path, dset, name, 1, dims, err)
     if (.not. allocated(err)) then
-      allocate (x(dims(1)))
-      h = 0
-      if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_INTEGER, x, dims, h)
-      if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      allocate (x(dims(1)), stat=h)   ! a damaged file may claim any size
+      if (h /= 0) then
+        allocate (x(0))
+        call fatal_error(err, who//': '//path//': /'//name//' claims '//itoa(dims(1))// &
+                         ' values, more than fit in memory')
+      else
+        if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_INTEGER, x, dims, h)
+        if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      end if
     end if
     call h5dclose_f(dset, i)
   end subroutine get_int_1d
