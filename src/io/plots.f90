@@ -63,6 +63,7 @@ contains
     ! The one shell of casca: `command -v` is the portable way to ask whether gnuplot is on
     ! PATH (dash answers 127 for "not found", which gfortran reports as a cmdstat failure,
     ! hence exit 99); the folder is one quoted word.
+    if (d(1:1) /= '/') d = './'//d   ! a folder named -x is not an option of cd
     cmd = 'cd '//shell_quote(d)//' && { command -v gnuplot >/dev/null 2>&1 || exit 99; } && ' &
           //'gnuplot plots.gp'
     cmsg = ''
