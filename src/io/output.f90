@@ -14,6 +14,8 @@ module casca_output
                            h5_table_close
   use casca_mpi, only: is_root
   use casca_files, only: make_dir, rename_file, delete_file
+  use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
+                                cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder
   implicit none
   private
@@ -22,7 +24,7 @@ module casca_output
 
   type :: output_t
     character(len=:), allocatable :: dir
-    integer :: hist = 0                 !< unit of history.dat (newunit: negative)
+    type(checked_file_t) :: hist        !< history.dat
     logical :: hist_open = .false.
     type(h5_table_t) :: h5
     integer :: nframes = 0
@@ -67,7 +69,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     character(len=16), allocatable :: cols(:)
     character(len=:), allocatable :: note
-    integer :: ios, k
+    integer :: ios
     character(len=256) :: msg
 
     out%dir = trim(dir)
@@ -81,21 +83,16 @@ contains
     if (allocated(err)) return
     out%locked = .true.
     if (note /= '') write (0, '(a)') 'warning: '//note
-    call write_lines(out%dir//'/tracked.txt', labels, err)
+    call write_file_atomic(out%dir//'/tracked.txt', lines(labels), err)
     if (allocated(err)) return
     cols = history_columns(size(tracked))
     if (restart_step < 0) then
-      open (newunit=out%hist, file=out%dir//'/history.dat', status='replace', iostat=ios, &
-            iomsg=msg)
-      if (ios /= 0) then
-        call fatal_error(err, out%dir//'/history.dat: '//trim(msg)); return
-      end if
+      call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
+      if (allocated(err)) return
       out%hist_open = .true.
-      write (out%hist, '(a,*(1x,a))', iostat=ios, iomsg=msg) '#', (trim(cols(k)), k=1, size(cols))
-      if (ios /= 0) then
-        call fatal_error(err, out%dir//'/history.dat: cannot write: '//trim(msg)); return
-      end if
-      call h5_table_create(out%h5, out%dir//'/history.h5', cols, err)
+      call cf_write(out%hist, lines(['#' // cat(cols)]), err)
+      if (allocated(err)) return
+      call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     else
       call keep_history(out, cols, restart_step, err)
       if (allocated(err)) return
@@ -146,7 +143,7 @@ contains
     path = out%dir//'/history.dat'
     call cut_history(path, size(cols), last, err)
     if (allocated(err)) return
-    call h5_table_create(out%h5, out%dir//'/history.h5', cols, err)
+    call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     if (allocated(err)) return
     open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     do while (ios == 0 .and. .not. allocated(err))
@@ -159,12 +156,8 @@ contains
     close (u)
     if (.not. allocated(err)) call h5_table_flush(out%h5, err)
     if (allocated(err)) return
-    open (newunit=out%hist, file=path, status='old', position='append', action='write', &
-          iostat=ios, iomsg=msg)
-    if (ios /= 0) then
-      call fatal_error(err, 'restart: '//path//': '//trim(msg)); return
-    end if
-    out%hist_open = .true.
+    call cf_open(out%hist, path, 'a', err)
+    out%hist_open = .not. allocated(err)
   end subroutine keep_history
 
   !> Replace the history file path by its header and rows (of ncol numbers) up to step last,
@@ -173,66 +166,60 @@ contains
     character(len=*), intent(in) :: path
     integer, intent(in) :: ncol, last
     type(error_t), allocatable, intent(out) :: err
+    type(checked_file_t) :: part
     character(len=max_line) :: buf
     character(len=256) :: msg
     real(dp) :: row(ncol)
-    integer :: ui, uo, ios, step
-    open (newunit=ui, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+    integer :: u, ios, step
+    open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       call fatal_error(err, 'restart: '//path//': '//trim(msg)); return
     end if
-    open (newunit=uo, file=path//'.part', status='replace', action='write', iostat=ios, iomsg=msg)
-    if (ios /= 0) then
-      close (ui)
-      call fatal_error(err, 'restart: '//path//'.part: '//trim(msg)); return
-    end if
+    call cf_open(part, path//'.part', 'w', err)
     step = -1
-    do
-      read (ui, '(a)', iostat=ios) buf
+    do while (.not. allocated(err))
+      read (u, '(a)', iostat=ios) buf
       if (ios /= 0) exit
       if (buf(1:1) /= '#') then
         read (buf, *, iostat=ios) row
         if (ios /= 0 .or. nint(row(2)) > last) exit
         step = nint(row(2))
       end if
-      write (uo, '(a)', iostat=ios, iomsg=msg) trim(buf)
-      if (ios /= 0) then
-        call fatal_error(err, 'restart: '//path//'.part: cannot write: '//trim(msg)); exit
-      end if
+      call cf_write(part, trim(buf)//new_line('a'), err)
     end do
-    close (ui)
-    if (.not. allocated(err)) close (uo, iostat=ios, iomsg=msg)
-    if (.not. allocated(err) .and. ios > 0) &
-      call fatal_error(err, 'restart: '//path//'.part: '//trim(msg))
+    close (u)
+    if (.not. allocated(err)) call cf_close(part, err)
     if (.not. allocated(err) .and. step /= last) &
       call fatal_error(err, 'restart: '//path//' ends at step '//itoa(step)// &
                        ', before the checkpoint''s step '//itoa(last)//' (another run''s history?)')
     if (allocated(err)) then
-      close (uo, status='delete', iostat=ios)
-      call delete_file(path//'.part'); return
+      call cf_discard(part); return
     end if
     if (.not. rename_file(path//'.part', path)) &
       call fatal_error(err, 'restart: cannot rename '//path//'.part to '//path)
   end subroutine cut_history
 
-  !> lines(:), trimmed, as the file path: written to path.part, renamed when complete
-  subroutine write_lines(path, lines, err)
-    character(len=*), intent(in) :: path, lines(:)
-    type(error_t), allocatable, intent(out) :: err
-    integer :: u, ios, k
-    character(len=256) :: msg
-    open (newunit=u, file=path//'.part', status='replace', action='write', iostat=ios, iomsg=msg)
-    do k = 1, size(lines)
-      if (ios == 0) write (u, '(a)', iostat=ios, iomsg=msg) trim(lines(k))
+  !> The lines, trimmed, each ended by a newline, as one text
+  pure function lines(l) result(text)
+    character(len=*), intent(in) :: l(:)
+    character(len=:), allocatable :: text
+    integer :: k
+    text = ''
+    do k = 1, size(l)
+      text = text//trim(l(k))//new_line('a')
     end do
-    if (ios == 0) close (u, iostat=ios, iomsg=msg)
-    if (ios /= 0) then
-      close (u, status='delete', iostat=k)
-      call fatal_error(err, path//': cannot write: '//trim(msg)); return
-    end if
-    if (.not. rename_file(path//'.part', path)) &
-      call fatal_error(err, 'cannot rename '//path//'.part to '//path)
-  end subroutine write_lines
+  end function lines
+
+  !> The words, trimmed, each after a blank
+  pure function cat(words) result(text)
+    character(len=*), intent(in) :: words(:)
+    character(len=:), allocatable :: text
+    integer :: k
+    text = ''
+    do k = 1, size(words)
+      text = text//' '//trim(words(k))
+    end do
+  end function cat
 
   !> One row: time, energies, momenta, contacts, Newton iterations, deepest penetration of a
   !> node without constraint, negative pivots of the last factorisation (the inertia of the
@@ -245,8 +232,8 @@ contains
     real(dp), intent(in) :: fcontact, penetration
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: row(:)
-    integer :: k, n, ios
-    character(len=256) :: msg
+    character(len=max_line) :: line
+    integer :: k, n
     if (.not. is_root()) return
     row = [st%t, real(st%step, dp), bal%kinetic, bal%strain, bal%work, bal%total, bal%p, bal%l, &
            real(contacts, dp), fcontact, real(newton, dp), penetration, real(neg_pivots, dp)]
@@ -254,11 +241,9 @@ contains
       n = out%tracked(k)
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]
     end do
-    write (out%hist, '(es23.15e3,1x,i0,*(1x,es23.15e3))', iostat=ios, iomsg=msg) row(1), &
-      st%step, row(3:)
-    if (ios /= 0) then
-      call fatal_error(err, out%dir//'/history.dat: cannot write: '//trim(msg)); return
-    end if
+    write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
+    call cf_write(out%hist, trim(line)//new_line('a'), err)
+    if (allocated(err)) return
     out%rows = out%rows + 1
     call h5_table_append(out%h5, row, err)
   end subroutine output_history
@@ -268,13 +253,9 @@ contains
   subroutine output_flush(out, err)
     type(output_t), intent(inout) :: out
     type(error_t), allocatable, intent(out) :: err
-    integer :: ios
     if (.not. is_root() .or. .not. out%hist_open) return
-    flush (out%hist, iostat=ios)
-    if (ios /= 0) then
-      call fatal_error(err, out%dir//'/history.dat: cannot write (is the disk full?)'); return
-    end if
-    call h5_table_flush(out%h5, err)
+    call cf_flush(out%hist, err)
+    if (.not. allocated(err)) call h5_table_flush(out%h5, err)
   end subroutine output_flush
 
   !> A VTU frame of the state and its entry in run.pvd. extra: more point fields (contact).
@@ -321,14 +302,9 @@ contains
   subroutine output_close(out, err)
     type(output_t), intent(inout) :: out
     type(error_t), allocatable, intent(out) :: err
-    integer :: ios
-    character(len=256) :: msg
     if (.not. is_root()) return
-    if (out%hist_open) then
-      close (out%hist, iostat=ios, iomsg=msg)
-      out%hist_open = .false.
-      if (ios /= 0) call fatal_error(err, out%dir//'/history.dat: cannot write: '//trim(msg))
-    end if
+    if (out%hist_open) call cf_close(out%hist, err)
+    out%hist_open = .false.
     if (.not. allocated(err)) call h5_table_flush(out%h5, err)
     if (.not. allocated(err)) call h5_table_close(out%h5, err)
     call output_release(out)
@@ -339,9 +315,8 @@ contains
   subroutine output_release(out)
     type(output_t), intent(inout) :: out
     type(error_t), allocatable :: e
-    integer :: ios
     if (.not. is_root()) return
-    if (out%hist_open) close (out%hist, iostat=ios)
+    if (out%hist_open) call cf_close(out%hist, e)
     out%hist_open = .false.
     call h5_table_close(out%h5, e)
     if (out%locked) call unlock_folder(out%dir)

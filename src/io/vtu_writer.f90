@@ -205,15 +205,21 @@ contains
     character(len=*), intent(in) :: msg_write, tmp, path, who
     type(error_t), allocatable, intent(out) :: err
     character(len=msg_len) :: msg
-    integer :: ios, tmp_unit
+    integer :: ios, tmp_unit, pos, size
 
     if (ios_write /= 0) then
       close (u, status='delete', iostat=ios)
       call fatal_error(err, who//': error writing '//tmp//': '//trim(msg_write))
       return
     end if
+    inquire (unit=u, pos=pos)
     close (u, status='keep', iostat=ios, iomsg=msg)
-    if (ios /= 0) then
+    ! gfortran loses a full disk's error for buffered data: compare the size with what was written
+    inquire (file=tmp, size=size)
+    if (ios == 0 .and. size /= pos - 1) msg = 'the file is shorter than written (is the disk full?)'
+    if (ios /= 0 .or. size /= pos - 1) then
+      open (newunit=tmp_unit, file=tmp, status='old', iostat=ios)
+      if (ios == 0) close (tmp_unit, status='delete', iostat=ios)
       call fatal_error(err, who//': error closing '//tmp//': '//trim(msg))
       return
     end if
