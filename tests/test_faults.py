@@ -234,4 +234,60 @@ try:
 except subprocess.TimeoutExpired:
     ck.record("2 ranks, output folder cannot be made: exit 2", False, "hung for 60 s")
 
+# --- a full disk (small tmpfs, filled at different moments by its size): a message and a
+# non-zero exit, never a signal; no file under its final name is cut short, no .part is left
+import xml.etree.ElementTree as ET
+import meshio
+
+
+def complete_outputs(folder):
+    """names of the files in folder that are not complete and readable ([] if all are)"""
+    bad = [f for f in os.listdir(folder) if f.endswith(".part")]
+    for f in os.listdir(folder):
+        path = os.path.join(folder, f)
+        try:
+            if f.endswith(".vtu"):
+                meshio.read(path)
+            elif f.endswith(".h5"):
+                with h5py.File(path, "r") as g:
+                    list(g)
+            elif f == "run.pvd":
+                for d in ET.parse(path).getroot().iter("DataSet"):
+                    if not os.path.exists(os.path.join(folder, d.get("file"))):
+                        bad.append(d.get("file"))
+            elif f == "history.dat":
+                text = open(path).read()
+                ncol = len(text.splitlines()[0].split()) - 1
+                if not text.endswith("\n") or any(len(l.split()) != ncol for l in text.splitlines()[1:]):
+                    bad.append(f)
+        except Exception as e:
+            bad.append("%s (%s)" % (f, str(e)[:60]))
+    return bad
+
+
+disk = os.path.join(work, "disk")
+os.makedirs(disk)
+mounted = False
+if os.geteuid() != 0:
+    print("SKIP full disk: not root, cannot mount a small tmpfs")
+else:
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=600k", "tmpfs", disk], capture_output=True, text=True)
+    mounted = m.returncode == 0
+    if not mounted:
+        print("SKIP full disk: mount -t tmpfs failed: " + m.stderr.strip())
+try:
+    for size in (["100k", "200k", "300k", "600k"] if mounted else []):
+        subprocess.run(["mount", "-o", "remount,size=" + size, disk], check=True)
+        out = os.path.join(disk, "o")
+        shutil.rmtree(out, ignore_errors=True)
+        p = run([casca, "run", deck("disk", t_end="3.0e-3", out=out), "-q"])
+        ok = p.returncode in (2, 3) and clean(p) and "disk full" in p.stderr
+        bad = complete_outputs(out) if os.path.isdir(out) else []
+        ck.record("disk of %s filled by the run: non-zero exit (no signal), a message" % size, ok, first_line(p))
+        ck.record("disk of %s: every file under its final name complete, no .part left" % size, not bad,
+                  "incomplete: %s" % bad)
+finally:
+    if mounted:
+        subprocess.run(["umount", disk])
+
 ck.finish()

@@ -2,10 +2,10 @@
 !> never sees a half-written result; making folders. Fortran 2008 has neither rename nor mkdir,
 !> so the C library's are used (never a shell: a name is then only a name).
 module casca_files
-  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_long
   implicit none
   private
-  public :: rename_file, delete_file, make_dir, is_dir
+  public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line
 
   interface
     function c_rename(old, new) bind(c, name='rename') result(stat)
@@ -20,6 +20,13 @@ module casca_files
       integer(c_int), value :: mode   ! mode_t: unsigned int on Linux
       integer(c_int) :: stat
     end function c_mkdir
+
+    function c_truncate(path, length) bind(c, name='truncate') result(stat)
+      import :: c_char, c_int, c_long
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_long), value :: length   ! off_t: 64 bits on Linux x86_64
+      integer(c_int) :: stat
+    end function c_truncate
   end interface
 
 contains
@@ -48,6 +55,24 @@ contains
     character(len=*), intent(in) :: path
     inquire (file=path//'/.', exist=is_dir)
   end function is_dir
+
+  !> Cut a text file after its last newline: a line half-written when the disk filled up is
+  !> not left looking like a row.
+  subroutine cut_to_last_line(path)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: text
+    integer :: u, ios, n, stat
+    open (newunit=u, file=path, access='stream', form='unformatted', status='old', &
+          action='read', iostat=ios)
+    if (ios /= 0) return
+    inquire (unit=u, size=n)
+    allocate (character(len=max(n, 0)) :: text)
+    if (n > 0) read (u, iostat=ios) text
+    close (u)
+    if (ios /= 0 .or. n <= 0) return
+    if (text(n:n) /= new_line('a')) stat = c_truncate(path//c_null_char, &
+                                                      int(index(text, new_line('a'), back=.true.), c_long))
+  end subroutine cut_to_last_line
 
   !> Remove a file if it exists (a failed .part).
   subroutine delete_file(path)

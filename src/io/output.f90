@@ -13,7 +13,7 @@ module casca_output
   use casca_hdf5_io, only: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, &
                            h5_table_close
   use casca_mpi, only: is_root
-  use casca_files, only: make_dir, rename_file, delete_file
+  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder
@@ -304,6 +304,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     if (.not. is_root()) return
     if (out%hist_open) call cf_close(out%hist, err)
+    if (allocated(err)) call cut_to_last_line(out%dir//'/history.dat')
     out%hist_open = .false.
     if (.not. allocated(err)) call h5_table_flush(out%h5, err)
     if (.not. allocated(err)) call h5_table_close(out%h5, err)
@@ -316,7 +317,10 @@ contains
     type(output_t), intent(inout) :: out
     type(error_t), allocatable :: e
     if (.not. is_root()) return
-    if (out%hist_open) call cf_close(out%hist, e)
+    if (out%hist_open) then
+      call cf_close(out%hist, e)
+      call cut_to_last_line(out%dir//'/history.dat')
+    end if
     out%hist_open = .false.
     call h5_table_close(out%h5, e)
     if (out%locked) call unlock_folder(out%dir)
