@@ -2,10 +2,14 @@
 !> never sees a half-written result; making folders. Fortran 2008 has neither rename nor mkdir,
 !> so the C library's are used (never a shell: a name is then only a name).
 module casca_files
-  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_long
+  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char, c_long, c_long_long
+  use, intrinsic :: iso_fortran_env, only: int64
   implicit none
   private
-  public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line
+  public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line, file_kind, &
+            physical_memory
+  !> kinds of file_kind
+  integer, parameter, public :: kind_missing = 0, kind_regular = 1, kind_folder = 2, kind_special = 3
 
   interface
     function c_rename(old, new) bind(c, name='rename') result(stat)
@@ -27,6 +31,18 @@ module casca_files
       integer(c_long), value :: length   ! off_t: 64 bits on Linux x86_64
       integer(c_int) :: stat
     end function c_truncate
+
+    function c_file_kind(path, size) bind(c, name='casca_file_kind') result(kind)   ! sysinfo.c
+      import :: c_char, c_int, c_long_long
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_long_long), intent(out) :: size
+      integer(c_int) :: kind
+    end function c_file_kind
+
+    function c_physical_memory() bind(c, name='casca_physical_memory') result(bytes)
+      import :: c_long_long
+      integer(c_long_long) :: bytes
+    end function c_physical_memory
   end interface
 
 contains
@@ -73,6 +89,21 @@ contains
     if (text(n:n) /= new_line('a')) stat = c_truncate(path//c_null_char, &
                                                       int(index(text, new_line('a'), back=.true.), c_long))
   end subroutine cut_to_last_line
+
+  !> kind_missing, kind_regular, kind_folder or kind_special (FIFO, device, socket) of the
+  !> file path, and its size in bytes (64 bits)
+  integer function file_kind(path, size)
+    character(len=*), intent(in) :: path
+    integer(int64), intent(out), optional :: size
+    integer(c_long_long) :: bytes
+    file_kind = c_file_kind(path//c_null_char, bytes)
+    if (present(size)) size = bytes
+  end function file_kind
+
+  !> Physical memory of the machine in bytes (0 if unknown)
+  integer(int64) function physical_memory()
+    physical_memory = c_physical_memory()
+  end function physical_memory
 
   !> Remove a file if it exists (a failed .part).
   subroutine delete_file(path)

@@ -7,11 +7,15 @@ module casca_gmsh_io
   use casca_kinds, only: dp, i8
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
+  use casca_files, only: file_kind, kind_folder, kind_special, kind_regular
+  use, intrinsic :: iso_fortran_env, only: int64
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: read_gmsh, write_gmsh
 
   integer, parameter :: tri10_type = 21
+  real(dp), parameter :: max_coordinate = 1e15_dp   !< [m]: far beyond any scene, far below overflow
 
   !> Position in the in-memory file: the next line starts at buf(pos:); `line` is the number of
   !> the line last returned (0 before the first).
@@ -443,6 +447,13 @@ contains
     integer :: i, k, ie, pos, n_used
     character(len=24) :: tagstr
 
+    do i = 1, raw%nnode   ! (a NaN, an Inf or 1e308 would pass every later check)
+      if (.not. all(ieee_is_finite(raw%x(:, i)) .and. abs(raw%x(:, i)) <= max_coordinate)) then
+        cur%line = raw%node_line(i)
+        call fail(err, cur, "node coordinates must be finite numbers of size below 1e15 m")
+        return
+      end if
+    end do
     allocate (order(raw%nnode))
     call merge_sort_index(raw%node_tag(1:raw%nnode), order)
     sorted_tag = raw%node_tag(order)
@@ -500,9 +511,20 @@ contains
     type(cursor_t), intent(out) :: cur
     type(error_t), allocatable, intent(out) :: err
     integer :: u, ios, nbytes
+    integer(int64) :: size
     character(len=512) :: msg
 
     cur%path = path
+    select case (file_kind(path, size))   ! a FIFO would block the read forever
+    case (kind_folder, kind_special)
+      call fatal_error(err, path // ": not a regular file (a folder, FIFO or device)")
+      return
+    case (kind_regular)
+      if (size > huge(nbytes)) then
+        call fatal_error(err, path // ": larger than 2 GiB; meshes are read up to 2 GiB")
+        return
+      end if
+    end select
     open (newunit=u, file=path, status='old', action='read', access='stream', form='unformatted', &
           iostat=ios, iomsg=msg)
     if (ios /= 0) then
