@@ -290,4 +290,50 @@ finally:
     if mounted:
         subprocess.run(["umount", disk])
 
+# --- bad numbers and names: refused with exit 2 before anything is allocated, the file and
+# line named (lines counted in the deck text above: &run on line 1, ring1's &body on line 10)
+lines = open(ring).read().split("\n")
+first_xyz = lines.index("$Nodes") + 3 + 240   # MSH 4.1: summary, block header, 240 tags
+bad_meshes = {}
+for name, value in (("nan", "nan 0 0"), ("inf", "1.0 inf 0"), ("huge", "1e308 0 0")):
+    path = os.path.join(work, "coord_%s.msh" % name)
+    with open(path, "w") as f:
+        f.write("\n".join(lines[:first_xyz] + [value] + lines[first_xyz + 1:]))
+    bad_meshes[name] = path
+fifo = os.path.join(work, "mesh.fifo")
+os.mkfifo(fifo)
+one_ring = "'ring1', mesh = 'file', file = '%s'" % ring
+cases = [  # (name, old, new, substrings of the message)
+    ("t_end = Infinity", "t_end = 1.0e-2", "t_end = Infinity", [":1:", "t_end", "below 1e30"]),
+    ("dt = NaN", "dt = 5.0e-5", "dt = NaN", [":1:", "dt", "> 0"]),
+    ("young = 1e308", "young = 210e9", "young = 1e308", [":10:", "young", "below 1e30"]),
+    ("velocity NaN", "velocity = 10.0", "velocity = NaN", [":10:", "velocity", "finite"]),
+    ("n_around = 1e9", one_ring, "'ring1', mesh = 'ring', n_around = 1000000000", [":10:", "elements"]),
+    ("n_div = 1e5", one_ring, "'ring1', mesh = 'sphere', n_div = 100000", [":10:", "elements"]),
+    ("newton_max_iter = 200", "dt = 5.0e-5", "dt = 5.0e-5, newton_max_iter = 200", [":1:", "newton_max_iter", "1..100"]),
+    ("max_step_cuts = 60", "dt = 5.0e-5", "dt = 5.0e-5, max_step_cuts = 60", [":1:", "max_step_cuts", "0..30"]),
+    ("checkpoint_interval = -Infinity", "checkpoint_interval = 5.0e-4", "checkpoint_interval = -Infinity",
+     [":4:", "checkpoint_interval"]),
+    ("302-character dir", "dir = 'x'", "dir = '%s'" % ("d" * 302), [":4:", "dir", "longer than 256"]),
+    ("200-character body name", "'ring1', mesh", "'%s', mesh" % ("r" * 200), [":10:", "name", "longer than 64"]),
+    ("5000-character line", "/\n&body", "/\n!%s\n&body" % ("c" * 5000), [":10:", "line longer than 4096"]),
+    ("self-contact", "young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n/\n&body",
+     "young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n/\n&contact\n pairs = 'ring1', 'ring1'\n/\n&body",
+     ["&contact", "itself"]),
+    ("FIFO as mesh", one_ring, "'ring1', mesh = 'file', file = '%s'" % fifo, [":10:", "mesh.fifo", "not a regular file"]),
+] + [("%s coordinate in the mesh" % n, one_ring, "'ring1', mesh = 'file', file = '%s'" % p,
+      ["coord_%s.msh:%d:" % (n, first_xyz + 1), "finite"]) for n, p in bad_meshes.items()]
+for name, old, new, needles in cases:
+    path = deck("badnum", out="x")
+    text = open(path).read()
+    assert old in text, old
+    with open(path, "w") as f:
+        f.write(text.replace(old, new, 1))
+    try:
+        p = run([casca, "check", path], timeout=30)
+        ok = p.returncode == 2 and clean(p) and all(n in p.stderr for n in needles)
+        ck.record("%s: exit 2, message with %s" % (name, needles), ok, first_line(p)[:200])
+    except subprocess.TimeoutExpired:
+        ck.record("%s: exit 2" % name, False, "hung for 30 s")
+
 ck.finish()

@@ -289,6 +289,8 @@ contains
           call fail(err, cur, "expected 3 node coordinates 'x y z', found '" // clip(cur%buf(s:e)) // "'")
           return
         end if
+        call check_coordinates(cur, raw%x(:, first + k), err)
+        if (allocated(err)) return
       end do
       raw%nnode = first + nin
     end do
@@ -321,6 +323,8 @@ contains
         call fail(err, cur, "expected 'node-tag x y z', found '" // clip(cur%buf(s:e)) // "'")
         return
       end if
+      call check_coordinates(cur, raw%x(:, k), err)
+      if (allocated(err)) return
       raw%node_line(k) = cur%line
     end do
     raw%nnode = n
@@ -447,13 +451,6 @@ contains
     integer :: i, k, ie, pos, n_used
     character(len=24) :: tagstr
 
-    do i = 1, raw%nnode   ! (a NaN, an Inf or 1e308 would pass every later check)
-      if (.not. all(ieee_is_finite(raw%x(:, i)) .and. abs(raw%x(:, i)) <= max_coordinate)) then
-        cur%line = raw%node_line(i)
-        call fail(err, cur, "node coordinates must be finite numbers of size below 1e15 m")
-        return
-      end if
-    end do
     allocate (order(raw%nnode))
     call merge_sort_index(raw%node_tag(1:raw%nnode), order)
     sorted_tag = raw%node_tag(order)
@@ -504,6 +501,16 @@ contains
 
   ! ---------------------------------------------------------------------------------------------
   ! Helpers
+
+  !> Coordinates on the current line must be finite and below max_coordinate in size (a NaN,
+  !> an Inf or 1e308 would pass every later check)
+  subroutine check_coordinates(cur, x, err)
+    type(cursor_t), intent(inout) :: cur
+    real(dp), intent(in) :: x(3)
+    type(error_t), allocatable, intent(out) :: err
+    if (.not. all(ieee_is_finite(x) .and. abs(x) <= max_coordinate)) &
+      call fail(err, cur, "node coordinates must be finite numbers of size below 1e15 m")
+  end subroutine check_coordinates
 
   !> Read the whole file as bytes (stream access never trips over line-ending quirks).
   subroutine load_file(path, cur, err)
