@@ -362,6 +362,7 @@ contains
         ' s: ', why
       call frame()
       call checkpoint()
+      call solver%finish()
       call output_close(out, e)
       if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
         '/checkpoint.h5 (restart with --restart) and in the last frame of '//dir//'/run.pvd'
@@ -370,6 +371,7 @@ contains
 
     subroutine finish()
       type(error_t), allocatable :: e
+      call solver%finish()
       call output_close(out, e)
       call share_error(e)
       if (allocated(e)) then
