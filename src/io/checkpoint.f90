@@ -13,6 +13,7 @@ module casca_checkpoint
   use casca_contact, only: contact_t
   use casca_hdf5_io, only: write_checkpoint, read_checkpoint
   use casca_mpi, only: is_root
+  use casca_strings, only: itoa
   implicit none
   private
   public :: save_checkpoint, load_checkpoint, model_fingerprint
@@ -155,12 +156,4 @@ contains
       contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
     end do
   end subroutine load_checkpoint
-
-  pure function itoa(n) result(s)
-    integer, intent(in) :: n
-    character(len=:), allocatable :: s
-    character(len=16) :: b
-    write (b, '(i0)') n
-    s = trim(b)
-  end function itoa
 end module casca_checkpoint

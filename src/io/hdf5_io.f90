@@ -712,8 +712,7 @@ contains
       allocate (x(dims(1)), stat=h)   ! a damaged file may claim any size
       if (h /= 0) then
         allocate (x(0))
-        call fatal_error(err, who//': '//path//': /'//name//' claims '//itoa(dims(1))// &
-                         ' values, more than fit in memory')
+        call too_large(who, path, name, dims(1), err)
       else
         if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, x, dims, h)
         if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
@@ -737,8 +736,7 @@ contains
       allocate (x(dims(1)), stat=h)   ! a damaged file may claim any size
       if (h /= 0) then
         allocate (x(0))
-        call fatal_error(err, who//': '//path//': /'//name//' claims '//itoa(dims(1))// &
-                         ' values, more than fit in memory')
+        call too_large(who, path, name, dims(1), err)
       else
         if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_INTEGER, x, dims, h)
         if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
@@ -746,6 +744,15 @@ contains
     end if
     call h5dclose_f(dset, i)
   end subroutine get_int_1d
+
+  !> The error of a dataset whose claimed size cannot be allocated
+  subroutine too_large(who, path, name, n, err)
+    character(len=*), intent(in) :: who, path, name
+    integer(hsize_t), intent(in) :: n
+    type(error_t), allocatable, intent(out) :: err
+    call fatal_error(err, who//': '//path//': /'//name//' claims '//itoa(n)// &
+                     ' values, more than fit in memory')
+  end subroutine too_large
 
   !> Close a half-built file after an error (ids of -1 are skipped).
   subroutine abandon(fid, dset)

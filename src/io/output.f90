@@ -13,6 +13,7 @@ module casca_output
   use casca_hdf5_io, only: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, &
                            h5_table_close
   use casca_mpi, only: is_root
+  use casca_strings, only: itoa
   use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
@@ -83,14 +84,14 @@ contains
     if (allocated(err)) return
     out%locked = .true.
     if (note /= '') write (0, '(a)') 'warning: '//note
-    call write_file_atomic(out%dir//'/tracked.txt', lines(labels), err)
+    call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
     cols = history_columns(size(tracked))
     if (restart_step < 0) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return
       out%hist_open = .true.
-      call cf_write(out%hist, lines(['#' // cat(cols)]), err)
+      call cf_write(out%hist, '#'//join(cols, ' ', '')//new_line('a'), err)
       if (allocated(err)) return
       call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     else
@@ -199,27 +200,16 @@ contains
       call fatal_error(err, 'restart: cannot rename '//path//'.part to '//path)
   end subroutine cut_history
 
-  !> The lines, trimmed, each ended by a newline, as one text
-  pure function lines(l) result(text)
-    character(len=*), intent(in) :: l(:)
-    character(len=:), allocatable :: text
-    integer :: k
-    text = ''
-    do k = 1, size(l)
-      text = text//trim(l(k))//new_line('a')
-    end do
-  end function lines
-
-  !> The words, trimmed, each after a blank
-  pure function cat(words) result(text)
-    character(len=*), intent(in) :: words(:)
+  !> The words, trimmed, each between before and after, as one text
+  pure function join(words, before, after) result(text)
+    character(len=*), intent(in) :: words(:), before, after
     character(len=:), allocatable :: text
     integer :: k
     text = ''
     do k = 1, size(words)
-      text = text//' '//trim(words(k))
+      text = text//before//trim(words(k))//after
     end do
-  end function cat
+  end function join
 
   !> One row: time, energies, momenta, contacts, Newton iterations, deepest penetration of a
   !> node without constraint, negative pivots of the last factorisation (the inertia of the
@@ -326,12 +316,4 @@ contains
     if (out%locked) call unlock_folder(out%dir)
     out%locked = .false.
   end subroutine output_release
-
-  pure function itoa(n) result(s)
-    integer, intent(in) :: n
-    character(len=:), allocatable :: s
-    character(len=16) :: b
-    write (b, '(i0)') n
-    s = trim(b)
-  end function itoa
 end module casca_output

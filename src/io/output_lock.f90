@@ -7,6 +7,7 @@ module casca_output_lock
   use, intrinsic :: iso_c_binding, only: c_int
   use casca_error, only: error_t, fatal_error
   use casca_files, only: delete_file
+  use casca_strings, only: itoa
   implicit none
   private
   public :: lock_folder, unlock_folder
@@ -104,12 +105,4 @@ contains
     if (ios /= 0) holder = 0
     close (u, iostat=ios)
   end function holder
-
-  pure function itoa(n) result(s)
-    integer, intent(in) :: n
-    character(len=:), allocatable :: s
-    character(len=16) :: b
-    write (b, '(i0)') n
-    s = trim(b)
-  end function itoa
 end module casca_output_lock

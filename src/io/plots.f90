@@ -9,6 +9,7 @@
 !> Units are SI as the solver writes them (s, m, J, N); time is plotted in ms.
 module casca_plots
   use casca_error, only: error_t, fatal_error
+  use casca_strings, only: itoa
   implicit none
   private
   public :: make_plots
@@ -514,12 +515,4 @@ contains
       if (q(i:i) == achar(9) .or. q(i:i) == achar(13)) q(i:i) = ' '
     end do
   end function untab
-
-  pure function itoa(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=16) :: buf
-    write (buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
 end module casca_plots

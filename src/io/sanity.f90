@@ -6,6 +6,7 @@ module casca_sanity
   use casca_deck, only: deck_t, add_problem, unset, deck_file
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
   use casca_mesh_generators, only: generated_elements, max_generated_elements
+  use casca_strings, only: itoa
   implicit none
   private
   public :: check_deck, parse_fix
@@ -261,14 +262,6 @@ contains
         end if
       end do
     end function find_body
-
-    function itoa(k) result(s)
-      integer, intent(in) :: k
-      character(len=:), allocatable :: s
-      character(len=16) :: b
-      write (b, '(i0)') k
-      s = trim(b)
-    end function itoa
   end subroutine check_deck
 
   !> Components fixed by a restraint: 'clamped' (position and fibre), 'pinned' (position),
