@@ -9,8 +9,8 @@ program test_dynamics
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_plate, mesh_sphere
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
-  use casca_assembly, only: assembly_t, assembly_setup, nblocks
-  use casca_mumps_solver, only: sparse_solver_t
+  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_newmark, only: state_t, newmark_t, newmark_step
   use casca_accounting, only: balance_t, account
@@ -81,7 +81,7 @@ contains
     type(mesh_t) :: mesh
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver(nblocks)
+    type(linear_system_t) :: ls
     type(error_t), allocatable :: err
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
@@ -106,13 +106,13 @@ contains
     allocate (st%q(model%ndof), st%qd(model%ndof), st%qdd(model%ndof), zero(model%ndof))
     call reference_state(model, st%q)
     opts%tol = 1e-12_dp
-    call newton_solve(model, asm, solver, st%q, model%fext, opts, rep, err)
+    call newton_solve(model, asm, ls, st%q, model%fext, opts, rep, err)
     st%qd = 0; st%qdd = 0; zero = 0
     nm%beta = 0.25_dp; nm%gamma = 0.5_dp; nm%dt = 2*pi/omega/200
     ncross = 0
     wold = sum(st%q(dof(tip, 3)) - model%x0(3, tip))/ntip
     do s = 1, 800
-      call newmark_step(model, asm, solver, nm, zero, opts, st, rep, err)
+      call newmark_step(model, asm, ls, nm, zero, opts, st, rep, err)
       if (allocated(err)) error stop 'newmark'
       w = sum(st%q(dof(tip, 3)) - model%x0(3, tip))/ntip
       if (sign(1._dp, w) /= sign(1._dp, wold) .and. ncross < size(tcross)) then
@@ -121,7 +121,7 @@ contains
       end if
       wold = w
     end do
-    call solver(1)%finish()   ! one rank: block 1 only
+    call ls%finish()
     period = 2*(tcross(ncross) - tcross(1))/(ncross - 1)   ! crossings are half a period apart
     if (is_root()) print '(a,i0,a,f10.6,a,f10.6)', 'zero crossings: ', ncross, &
       ', omega = ', 2*pi/period, ', Euler-Bernoulli: ', omega
@@ -139,7 +139,7 @@ contains
     type(mesh_t) :: mesh
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver(nblocks)
+    type(linear_system_t) :: ls
     type(error_t), allocatable :: err
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
@@ -168,14 +168,14 @@ contains
     call account(model, asm, st, zero, q0, b0)
     dl = 0; de = 0; dpm = 0
     do s = 1, nsteps
-      call newmark_step(model, asm, solver, nm, zero, opts, st, rep, err)
+      call newmark_step(model, asm, ls, nm, zero, opts, st, rep, err)
       if (allocated(err)) error stop 'newmark'
       call account(model, asm, st, zero, q0, b)
       dpm = max(dpm, norm2(b%p - b0%p)/norm2(b0%p))
       dl = max(dl, norm2(b%l - b0%l)/norm2(b0%l))
       de = max(de, abs(b%total - b0%total)/b0%total)
     end do
-    call solver(1)%finish()   ! one rank: block 1 only
+    call ls%finish()
     if (present(qout)) qout = st%q
   end subroutine free_flight
 

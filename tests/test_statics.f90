@@ -7,8 +7,8 @@ program test_statics
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_plate
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
-  use casca_assembly, only: assembly_t, assembly_setup, nblocks
-  use casca_mumps_solver, only: sparse_solver_t
+  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_mpi, only: mpi_start, mpi_stop
   use casca_check, only: check_le, check_close, check_true, check_summary
@@ -80,7 +80,7 @@ contains
     type(mesh_t) :: mesh
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver(nblocks)
+    type(linear_system_t) :: ls
     type(error_t), allocatable :: err
     type(newton_opts_t) :: opts
     real(dp), allocatable :: q(:), f(:)
@@ -117,7 +117,7 @@ contains
     opts%reuse = .false.   ! full Newton: the rate test measures its order
     f = model%fext
     do lev = 1, nlev
-      call newton_solve(model, asm, solver, q, f*(real(lev, dp)/nlev), opts, rep, err)
+      call newton_solve(model, asm, ls, q, f*(real(lev, dp)/nlev), opts, rep, err)
       if (allocated(err)) error stop 'newton'
       wtip = 0; utip = 0
       do n = 1, model%nnode
@@ -130,6 +130,6 @@ contains
         wlev(lev) = wtip; ulev(lev) = utip
       end if
     end do
-    call solver(1)%finish()   ! one rank: block 1 only
+    call ls%finish()
   end subroutine cantilever
 end program test_statics

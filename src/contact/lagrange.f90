@@ -40,22 +40,12 @@ module casca_contact
     integer :: nact = 0
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
-    integer, allocatable :: last_irn(:), last_jcn(:)  !< constraint pattern last analysed
     real(dp), allocatable :: node_mass(:)       !< lumped (momentum) mass of each node
-    logical :: schur = .true.                   !< solve through the Schur complement of K
     logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
     ! the target elements at node n: node_elem(node_start(n) : node_start(n+1) - 1), and which
     ! of their nodes n is (node_loc); shape derivatives at the 10 nodes (dphi_node)
     integer, allocatable :: node_start(:), node_elem(:), node_loc(:)
     real(dp) :: dphi_node(10, 2, 10) = 0
-    ! Schur cache: Z = K^-1 C^T (block hosts, their rows) and S = C Z (LU, every rank) for
-    ! the constraints (z_node, z_elem) and their rows (z_irn, z_jcn, z_val), made with the
-    ! factors of K in use while z_current
-    real(dp), allocatable :: z(:, :), s(:, :)
-    integer, allocatable :: z_irn(:), z_jcn(:), z_ipiv(:), z_node(:), z_elem(:)
-    real(dp), allocatable :: z_val(:)
-    logical :: z_current = .false.
-    integer :: z_positive = 0                   !< positive eigenvalues of S
   end type contact_t
 
 contains
@@ -174,8 +164,12 @@ contains
         if (is_active(n, ip)) cycle
         call project(n, ip, cn, sd, found)
         if (.not. found) cycle
-        if (sd < -c%tol .and. has_free_position(n, cn%elem)) then
-          call finish(cn)
+        ! the sub-triangles are chords of the cubic surface, up to depth away from it: they
+        ! find the candidates, the constraint's own gap decides (else a node released with
+        ! zero gap would be taken again at once where the chord lies outside the surface)
+        if (sd >= c%depth(c%pair(2, ip)) .or. .not. has_free_position(n, cn%elem)) cycle
+        call finish(cn)
+        if (cn%gap < -c%tol) then
           call push(cn)
           added = added + 1
         end if
@@ -389,7 +383,7 @@ contains
     do k = 1, probe%nact
       if (any(c%act(1:c%nact)%node == probe%act(k)%node .and. &
               c%act(1:c%nact)%pair == probe%act(k)%pair)) cycle
-      free_pen = max(free_pen, -probe%act(k)%sd)
+      free_pen = max(free_pen, -probe%act(k)%gap)
     end do
     max_gap = 0
     if (c%nact > 0) max_gap = maxval(abs(c%act(1:c%nact)%gap))
@@ -423,10 +417,12 @@ contains
     real(dp), intent(in) :: tol
     type(contact_t), intent(out) :: probe
     probe%npairs = c%npairs; probe%pair = c%pair; probe%surf = c%surf; probe%depth = c%depth
+    probe%node_start = c%node_start; probe%node_elem = c%node_elem; probe%node_loc = c%node_loc
+    probe%dphi_node = c%dphi_node
     allocate (probe%grid(c%npairs), probe%grid_ok(c%npairs), probe%act(16))
     probe%grid_ok = .false.
     probe%tol = tol
-    probe%nodal_normal = .false.   ! the probes read signed distances only
+    probe%nodal_normal = c%nodal_normal   ! the gaps as the constraints measure them
   end subroutine new_probe
 
   !> Total normal contact force (sum of the compressive multipliers).

@@ -7,8 +7,8 @@ module casca_run
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs
   use casca_model, only: model_t, reference_state, dof
-  use casca_assembly, only: assembly_t, assembly_setup, nblocks
-  use casca_mumps_solver, only: sparse_solver_t
+  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
   use casca_accounting, only: balance_t, account, gravity_load
@@ -66,12 +66,12 @@ contains
       call reference_state(model, q)
       call contact_update(probe, model, q, .true., added)
       if (added == 0) return
-      worst = minloc(probe%act(1:probe%nact)%sd, dim=1)
+      worst = minloc(probe%act(1:probe%nact)%gap, dim=1)
       k = probe%act(worst)%node
       write (msg, '(a,a,a,a,a,i0,a,es10.3,a,i0,a)') 'bodies ''', &
         trim(model%body(model%node_body(k))%name), ''' and ''', &
         trim(model%body(pairs(2, probe%act(worst)%pair))%name), ''' overlap at the start: node ', &
-        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%sd, &
+        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, &
         ' m inside (', added, ' nodes in all); move them apart'
       call add_problem(deck, 0, trim(msg))
     end subroutine check_overlap
@@ -84,7 +84,7 @@ contains
     type(deck_t) :: deck
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(sparse_solver_t) :: solver(nblocks)   !< one per block of K (casca_assembly)
+    type(linear_system_t) :: ls
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
@@ -112,7 +112,7 @@ contains
     call setup_contact()
     call assembly_setup(model, asm, err, split=split_bodies())
     if (failed('setup')) return
-    if (deck%run%ordering == 'metis') solver%ordering = 1
+    if (deck%run%ordering == 'metis') ls%solver%ordering = 1
     opts%tol = deck%run%newton_tol; opts%max_iter = deck%run%newton_max_iter
     opts%reuse = deck%run%reuse_factorisation
     allocate (fgrav(model%ndof))
@@ -183,9 +183,9 @@ contains
       end if
       q_before = st%q; qd_before = st%qd
       if (use_contact) then
-        call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
+        call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
       else
-        call newmark_step(model, asm, solver, nm, fext, opts, st, rep, err)
+        call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err)
       end if
       if (allocated(err)) then
         if (level < deck%run%max_step_cuts) then
@@ -246,9 +246,7 @@ contains
       if (all(fz .eqv. frozen)) return
       frozen = fz
       call assembly_setup(model, asm, err, frozen, split_bodies())
-      do b = 1, nblocks
-        call solver(b)%new_pattern()
-      end do
+      call ls%new_pattern()
     end subroutine update_frozen
 
     !> The ranks that factorise and solve body b's block (when every body is solved)
@@ -272,17 +270,16 @@ contains
 
     !> K is block diagonal by body unless the constraints are factorised with it ('saddle')
     logical function split_bodies()
-      split_bodies = .true.
-      if (use_contact) split_bodies = contact%schur
+      split_bodies = ls%schur
     end function split_bodies
 
     subroutine setup_contact()
       integer, allocatable :: pairs(:, :)
       allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
       use_contact = size(pairs, 2) > 0
+      ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
       if (use_contact) then
         call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
-        contact%schur = deck%contact%solver == 'schur'
         contact%nodal_normal = deck%contact%normal == 'nodal'
       end if
     end subroutine setup_contact
@@ -336,10 +333,7 @@ contains
 
     subroutine checkpoint()
       type(error_t), allocatable :: e
-      integer :: s
-      do s = 1, nblocks   ! on every rank: a restart from here starts with new factors
-        call solver(s)%drop_factors()
-      end do
+      call ls%drop_factors()   ! on every rank: a restart from here starts with new factors
       call output_flush(out, e)   ! the history up to this step, for a restart from here
       if (.not. allocated(e) .and. use_contact) then
         call save_checkpoint(dir//'/checkpoint.h5', model, st, level, contact, e)
@@ -362,7 +356,7 @@ contains
         ' s: ', why
       call frame()
       call checkpoint()
-      call solver%finish()
+      call ls%finish()
       call output_close(out, e)
       if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
         '/checkpoint.h5 (restart with --restart) and in the last frame of '//dir//'/run.pvd'
@@ -371,7 +365,7 @@ contains
 
     subroutine finish()
       type(error_t), allocatable :: e
-      call solver%finish()
+      call ls%finish()
       call output_close(out, e)
       call share_error(e)
       if (allocated(e)) then
@@ -397,11 +391,11 @@ contains
       integer :: i
       do i = 1, deck%run%load_steps
         if (use_contact) then
-          call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
-                            opts, st%q, rep, err, contact)
+          call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
+                            deck%run%max_step_cuts, opts, st%q, rep, err, contact)
         else
-          call static_solve(model, asm, solver, fext*(real(i, dp)/deck%run%load_steps), 1, &
-                            opts, st%q, rep, err)
+          call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
+                            deck%run%max_step_cuts, opts, st%q, rep, err)
         end if
         if (allocated(err)) then
           call give_up(err%message); return

@@ -3,7 +3,7 @@ module casca_lapack
   use casca_kinds, only: dp
   implicit none
   private
-  public :: dsyev, dgetrf, dgetrs
+  public :: dsyev, dpotrf, dpotrs
 
   interface
     subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
@@ -14,19 +14,20 @@ module casca_lapack
       real(dp), intent(out) :: w(*), work(*)
       integer, intent(out) :: info
     end subroutine dsyev
-    subroutine dgetrf(m, n, a, lda, ipiv, info)
+    subroutine dpotrf(uplo, n, a, lda, info)
       import :: dp
-      integer, intent(in) :: m, n, lda
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, lda
       real(dp), intent(inout) :: a(lda, *)
-      integer, intent(out) :: ipiv(*), info
-    end subroutine dgetrf
-    subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+      integer, intent(out) :: info
+    end subroutine dpotrf
+    subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
       import :: dp
-      character, intent(in) :: trans
-      integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, nrhs, lda, ldb
       real(dp), intent(in) :: a(lda, *)
       real(dp), intent(inout) :: b(ldb, *)
       integer, intent(out) :: info
-    end subroutine dgetrs
+    end subroutine dpotrs
   end interface
 end module casca_lapack

@@ -4,10 +4,10 @@ module casca_newmark
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t
-  use casca_assembly, only: assembly_t, nblocks
-  use casca_mumps_solver, only: sparse_solver_t
+  use casca_assembly, only: assembly_t
+  use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t, constraint_t, contact_persistency
+  use casca_contact, only: contact_t, contact_persistency
   implicit none
   private
   public :: state_t, newmark_t, newmark_step, static_solve
@@ -27,10 +27,10 @@ contains
 
   !> One step s -> s+1 with external load fext (dead). On failure st and the contact's
   !> active set are unchanged.
-  subroutine newmark_step(model, asm, solver, nm, fext, opts, st, rep, err, contact)
+  subroutine newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
-    type(sparse_solver_t), intent(inout) :: solver(nblocks)
+    type(linear_system_t), intent(inout) :: ls
     type(newmark_t), intent(in) :: nm
     real(dp), intent(in) :: fext(:)
     type(newton_opts_t), intent(in) :: opts
@@ -40,7 +40,6 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp), allocatable :: qs(:), rs(:), q(:)
     real(dp) :: b, dt, g
-    type(constraint_t), allocatable :: saved(:)   ! the active set, kept for a failed step
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
     allocate (qs, rs, q, mold=st%q)   ! (not on assignment: gfortran warns, falsely)
@@ -49,21 +48,10 @@ contains
     ! predictor: the step taken with zero new acceleration
     q = st%q + dt*st%qd + dt*dt*(0.5_dp - b)*st%qdd
     where (model%fixed) q = st%q
-    if (present(contact)) then
-      saved = contact%act(1:contact%nact)
-      call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
-    else
-      call newton_solve(model, asm, solver, q, fext, opts, rep, err, 1/(b*dt*dt), qs)
-    end if
+    call newton_solve(model, asm, ls, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
     if (.not. allocated(err) .and. .not. rep%converged) &
       call fatal_error(err, 'Newton did not converge')
-    if (allocated(err)) then
-      if (present(contact)) then
-        contact%nact = size(saved)
-        contact%act(1:size(saved)) = saved
-      end if
-      return
-    end if
+    if (allocated(err)) return
     st%q = q
     st%qdd = q/(b*dt*dt) - qs
     st%qd = rs + g*dt*st%qdd
@@ -75,27 +63,44 @@ contains
     st%step = st%step + 1
   end subroutine newmark_step
 
-  !> Statics in nsteps equal load increments of fext; q holds the start and the result.
-  subroutine static_solve(model, asm, solver, fext, nsteps, opts, q, rep, err, contact)
+  !> Statics: the dead load fext scaled from factor from to factor to, in one increment if
+  !> Newton converges, else in halved increments (at most max_cuts halvings), growing back
+  !> after easy ones. q holds the start and the result; on failure it is the last converged
+  !> state and err says at which factor.
+  subroutine static_solve(model, asm, ls, fext, from, to, max_cuts, opts, q, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
-    type(sparse_solver_t), intent(inout) :: solver(nblocks)
-    real(dp), intent(in) :: fext(:)
-    integer, intent(in) :: nsteps
+    type(linear_system_t), intent(inout) :: ls
+    real(dp), intent(in) :: fext(:), from, to
+    integer, intent(in) :: max_cuts
     type(newton_opts_t), intent(in) :: opts
     real(dp), intent(inout) :: q(:)
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
-    integer :: i
-    do i = 1, nsteps
-      call newton_solve(model, asm, solver, q, fext*(real(i, dp)/nsteps), opts, rep, err, &
-                        contact=contact)
-      if (allocated(err)) return
-      if (.not. rep%converged) then
-        call fatal_error(err, 'static Newton did not converge')
-        return
+    real(dp) :: at, step
+    integer :: level, iters
+    character(len=120) :: msg
+    at = from; level = 0; iters = 0
+    do while (at < to - 1e-12_dp*abs(to - from))
+      step = min((to - from)/2**level, to - at)
+      call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact)
+      if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
+      if (allocated(err)) then
+        if (level >= max_cuts) then
+          write (msg, '(a,g0.6,a,i0,a)') 'static Newton did not converge at load factor ', &
+            at + step, ' (after ', level, ' halvings of the load step): '
+          err%message = trim(msg)//err%message
+          return
+        end if
+        level = level + 1   ! q is unchanged: half the increment
+        deallocate (err)
+        cycle
       end if
+      iters = iters + rep%iters
+      at = at + step
+      if (level > 0 .and. rep%iters <= 4) level = level - 1   ! Newton is at ease: grow back
     end do
+    rep%iters = iters
   end subroutine static_solve
 end module casca_newmark

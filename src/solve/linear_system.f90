@@ -1,0 +1,223 @@
+!> The linear algebra of one Newton iteration: the tangent K in diagonal blocks (one MUMPS
+!> instance each, casca_assembly), the constraint rows C, and the saddle-point system
+!>     [ K  C^T ] [ dq      ]   [ b ]
+!>     [ C  0   ] [ dlambda ] = [ c ]
+!> solved either through the Schur complement of K ('schur': K's pattern never changes; the
+!> cache of casca_schur keeps Z = K^-1 C^T and S = C Z while the rows and K's factors stay)
+!> or by factorising the whole matrix ('saddle': one block, re-analysed whenever the
+!> constraint pattern changes).
+module casca_linear_system
+  use casca_kinds, only: dp
+  use casca_error, only: error_t
+  use casca_model, only: model_t
+  use casca_assembly, only: assembly_t, nblocks
+  use casca_mumps_solver, only: sparse_solver_t
+  use casca_schur, only: schur_t, schur_valid, schur_store, schur_apply
+  use casca_metis, only: nested_dissection
+  use casca_mpi, only: sum_all, share_error
+  implicit none
+  private
+  public :: linear_system_t, rows_t, analyse_blocks, factorise_blocks, solve_blocks, kkt_solve, &
+            negative_pivots
+
+  !> Constraint rows in MUMPS's coordinates: entries (neq + k, eq) of dg_k/dq, a zero
+  !> diagonal (neq + k, neq + k) per multiplier, and the gaps; key(2, k): the (node, element)
+  !> of constraint k, which identifies its row while the point is held
+  type :: rows_t
+    integer, allocatable :: irn(:), jcn(:), key(:, :)
+    real(dp), allocatable :: val(:), gap(:)
+  end type rows_t
+
+  type :: linear_system_t
+    type(sparse_solver_t) :: solver(nblocks)   !< one per block of K (casca_assembly)
+    logical :: schur = .true.                  !< constraints through the Schur complement
+    type(schur_t) :: cache                     !< Z and S of the Schur path
+    integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
+  contains
+    procedure :: finish => system_finish
+    procedure :: drop_factors => system_drop_factors
+    procedure :: new_pattern => system_new_pattern
+  end type linear_system_t
+
+contains
+
+  !> Symbolic analysis of each block at its first solve and, with 'saddle', whenever the
+  !> constraint pattern in the matrix changes (its one block has the rows after K's equations).
+  subroutine analyse_blocks(ls, model, asm, rows, analyses, err)
+    type(linear_system_t), intent(inout) :: ls
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(in) :: asm
+    type(rows_t), intent(in) :: rows
+    integer, intent(inout) :: analyses
+    type(error_t), allocatable, intent(out) :: err
+    type(error_t), allocatable :: e
+    integer, allocatable :: perm(:), irn(:), jcn(:), cirn(:), cjcn(:)
+    integer :: nf, n, off, s, i
+    logical :: same
+    if (ls%schur) then   ! the constraints stay out of the factorised matrix
+      allocate (cirn(0), cjcn(0))
+    else
+      cirn = rows%irn; cjcn = rows%jcn
+    end if
+    same = .false.
+    if (allocated(ls%last_irn)) then
+      if (size(ls%last_irn) == size(cirn)) same = all(ls%last_irn == cirn) .and. all(ls%last_jcn == cjcn)
+    end if
+    nf = count(cirn == cjcn)   ! multipliers inside the factorised matrix
+    do s = 1, nblocks
+      if (asm%blk(s)%neq == 0 .or. (ls%solver(s)%analysed .and. same)) cycle
+      n = asm%blk(s)%neq; off = asm%blk(s)%off
+      irn = asm%irn(asm%blk(s)%first:asm%blk(s)%last)
+      jcn = asm%jcn(asm%blk(s)%first:asm%blk(s)%last)
+      if (s == 1) n = n + nf
+      if (s == 1 .and. asm%blk(s)%host) then
+        irn = [irn, cirn]; jcn = [jcn, cjcn]
+      end if
+      allocate (perm(0))
+      if (ls%solver(s)%ordering == 1 .and. asm%blk(s)%host) then
+        deallocate (perm); allocate (perm(n))
+        call nested_dissection(model%conn, model%nnode, &
+                               merge(asm%eq - off, 0, asm%eq > off .and. asm%eq <= off + asm%blk(s)%neq), &
+                               asm%blk(s)%neq, perm, e)
+        perm(asm%blk(s)%neq + 1:) = [(asm%blk(s)%neq + i, i=1, nf)]   ! multipliers last
+      end if
+      if (.not. allocated(e)) call ls%solver(s)%analyse(n, irn, jcn, perm, e, asm%blk(s)%ngroups)
+      if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+      deallocate (perm)
+      analyses = analyses + 1
+    end do
+    ls%last_irn = cirn; ls%last_jcn = cjcn
+    call share_error(err)
+  end subroutine analyse_blocks
+
+  !> Numerical factorisation of every block (with 'saddle', block 1 holds the rows' values).
+  !> The blocks factorise apart: all go on, or none.
+  subroutine factorise_blocks(ls, asm, rows, err)
+    type(linear_system_t), intent(inout) :: ls
+    type(assembly_t), intent(in) :: asm
+    type(rows_t), intent(in) :: rows
+    type(error_t), allocatable, intent(out) :: err
+    type(error_t), allocatable :: e
+    integer :: s
+    do s = 1, nblocks
+      if (asm%blk(s)%neq == 0) cycle
+      associate (a => asm%a(asm%blk(s)%first:asm%blk(s)%last))
+        if (asm%blk(s)%host .and. .not. ls%schur) then   ! 'saddle' has one block
+          call ls%solver(s)%factorise([a, rows%val], e)
+        else
+          call ls%solver(s)%factorise(a, e)
+        end if
+      end associate
+      if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+    end do
+    call share_error(err)
+    ls%cache%current = .false.   ! Z was made with the old factors
+  end subroutine factorise_blocks
+
+  !> xx = K^-1 bb block by block (rows: this rank's equations, then, with 'saddle', the
+  !> extra multipliers of its one block); zero in the blocks this rank does not host.
+  !> Every block is solved before the errors are shared: a block over several ranks is
+  !> collective, so a rank that stopped early would leave the others waiting.
+  subroutine solve_blocks(ls, asm, bb, xx, extra, err)
+    type(linear_system_t), intent(inout) :: ls
+    type(assembly_t), intent(in) :: asm
+    real(dp), intent(in) :: bb(:, :)
+    real(dp), intent(out) :: xx(:, :)
+    integer, intent(in) :: extra
+    type(error_t), allocatable, intent(out) :: err
+    type(error_t), allocatable :: e
+    integer :: lo, hi, s
+    xx = 0
+    do s = 1, nblocks
+      if (asm%blk(s)%neq == 0) cycle
+      lo = asm%blk(s)%off + 1
+      hi = asm%blk(s)%off + asm%blk(s)%neq + merge(extra, 0, s == 1)
+      call ls%solver(s)%solve(bb(lo:hi, :), xx(lo:hi, :), e)
+      if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+    end do
+    call share_error(err)
+  end subroutine solve_blocks
+
+  !> The saddle-point solve: b (asm%neq + nc) holds K's right-hand side then -gap; x the
+  !> increment of this rank's equations then dlambda (replicated with 'schur'; on the host
+  !> of block 1 with 'saddle'). With 'schur', the kept Z and S serve unless renew.
+  subroutine kkt_solve(ls, asm, rows, b, renew, x, err)
+    type(linear_system_t), intent(inout) :: ls
+    type(assembly_t), intent(in) :: asm
+    type(rows_t), intent(in) :: rows
+    real(dp), intent(in) :: b(:)
+    logical, intent(in) :: renew
+    real(dp), intent(out) :: x(:)
+    type(error_t), allocatable, intent(out) :: err
+    real(dp), allocatable :: bb(:, :), yy(:, :)
+    integer :: nc, e
+    nc = size(rows%gap)
+    if (.not. ls%schur .or. nc == 0) then
+      allocate (yy(size(b), 1))
+      call solve_blocks(ls, asm, reshape(b, [size(b), 1]), yy, merge(0, nc, ls%schur), err)
+      x = yy(:, 1)
+      return
+    end if
+    if (renew .or. .not. schur_valid(ls%cache, rows%key)) then   ! Z: nc + 1 right-hand sides
+      allocate (bb(asm%neq, nc + 1), yy(asm%neq, nc + 1))
+      bb = 0
+      bb(:, 1) = b(1:asm%neq)
+      do e = 1, size(rows%irn)
+        if (rows%irn(e) /= rows%jcn(e)) bb(rows%jcn(e), 1 + rows%irn(e) - asm%neq) = rows%val(e)
+      end do
+      call solve_blocks(ls, asm, bb, yy, 0, err)
+      if (allocated(err)) return
+      call schur_store(ls%cache, asm%neq, rows%irn, rows%jcn, rows%val, rows%key, yy(:, 2:), err)
+      if (allocated(err)) return
+    else                    ! the kept Z and S: one right-hand side
+      allocate (yy(asm%neq, 1))
+      call solve_blocks(ls, asm, reshape(b(1:asm%neq), [asm%neq, 1]), yy, 0, err)
+      if (allocated(err)) return
+    end if
+    call schur_apply(ls%cache, asm%neq, yy(:, 1), rows%gap, x)
+  end subroutine kkt_solve
+
+  !> Negative pivots of the factors in use, summed over the blocks and ranks, plus the
+  !> positive eigenvalues of S on the Schur path: the inertia of the saddle-point matrix.
+  integer function negative_pivots(ls, asm, nc)
+    type(linear_system_t), intent(in) :: ls
+    type(assembly_t), intent(in) :: asm
+    integer, intent(in) :: nc
+    integer :: s
+    negative_pivots = 0
+    do s = 1, nblocks
+      if (asm%blk(s)%neq > 0 .and. asm%blk(s)%host) &
+        negative_pivots = negative_pivots + ls%solver(s)%negative_pivots()
+    end do
+    call sum_all(negative_pivots)
+    if (ls%schur .and. nc > 0) negative_pivots = negative_pivots + ls%cache%positive
+  end function negative_pivots
+
+  subroutine system_finish(self)
+    class(linear_system_t), intent(inout) :: self
+    integer :: s
+    do s = 1, nblocks
+      call self%solver(s)%finish()
+    end do
+  end subroutine system_finish
+
+  !> The next solve refactorises (a restart from a checkpoint takes the same path).
+  subroutine system_drop_factors(self)
+    class(linear_system_t), intent(inout) :: self
+    integer :: s
+    do s = 1, nblocks
+      call self%solver(s)%drop_factors()
+    end do
+    self%cache%current = .false.
+  end subroutine system_drop_factors
+
+  !> The unknowns changed: the next solve analyses again.
+  subroutine system_new_pattern(self)
+    class(linear_system_t), intent(inout) :: self
+    integer :: s
+    do s = 1, nblocks
+      call self%solver(s)%new_pattern()
+    end do
+    self%cache%current = .false.
+  end subroutine system_new_pattern
+end module casca_linear_system
