@@ -277,15 +277,23 @@ else:
         print("SKIP full disk: mount -t tmpfs failed: " + m.stderr.strip())
 try:
     for size in (["100k", "200k", "300k", "600k"] if mounted else []):
-        subprocess.run(["mount", "-o", "remount,size=" + size, disk], check=True)
         out = os.path.join(disk, "o")
         shutil.rmtree(out, ignore_errors=True)
+        subprocess.run(["mount", "-o", "remount,size=" + size, disk], check=True)
         p = run([casca, "run", deck("disk", t_end="3.0e-3", out=out), "-q"])
         ok = p.returncode in (2, 3) and clean(p) and "disk full" in p.stderr
         bad = complete_outputs(out) if os.path.isdir(out) else []
         ck.record("disk of %s filled by the run: non-zero exit (no signal), a message" % size, ok, first_line(p))
         ck.record("disk of %s: every file under its final name complete, no .part left" % size, not bad,
                   "incomplete: %s" % bad)
+    if mounted:   # casca mesh writes its file the same way
+        shutil.rmtree(os.path.join(disk, "o"), ignore_errors=True)   # (a tmpfs shrinks only when empty)
+        subprocess.run(["mount", "-o", "remount,size=100k", disk], check=True)
+        msh = os.path.join(disk, "s.msh")
+        p = run([casca, "mesh", "sphere", "--n-div", "12", "-o", msh])
+        ck.record("casca mesh onto a full disk: exit 2, a message, no file left",
+                  p.returncode == 2 and clean(p) and "disk full" in p.stderr
+                  and not os.path.exists(msh) and not os.path.exists(msh + ".part"), first_line(p))
 finally:
     if mounted:
         subprocess.run(["umount", disk])

@@ -7,7 +7,7 @@ module casca_files
   implicit none
   private
   public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line, file_kind, &
-            physical_memory
+            physical_memory, close_complete
   !> kinds of file_kind
   integer, parameter, public :: kind_missing = 0, kind_regular = 1, kind_folder = 2, kind_special = 3
 
@@ -104,6 +104,18 @@ contains
   integer(int64) function physical_memory()
     physical_memory = c_physical_memory()
   end function physical_memory
+
+  !> Close the stream unit u, open on path, and tell whether path holds all that was written:
+  !> gfortran reports neither in WRITE nor in CLOSE that buffered data met a full disk.
+  logical function close_complete(u, path)
+    integer, intent(in) :: u
+    character(len=*), intent(in) :: path
+    integer(int64) :: pos, size
+    integer :: ios
+    inquire (unit=u, pos=pos)
+    close (u, iostat=ios)
+    close_complete = ios == 0 .and. file_kind(path, size) == kind_regular .and. size == pos - 1
+  end function close_complete
 
   !> Remove a file if it exists (a failed .part).
   subroutine delete_file(path)

@@ -7,7 +7,8 @@ module casca_gmsh_io
   use casca_kinds, only: dp, i8
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
-  use casca_files, only: file_kind, kind_folder, kind_special, kind_regular
+  use casca_files, only: file_kind, kind_folder, kind_special, kind_regular, close_complete, &
+                         delete_file, rename_file
   use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
@@ -146,7 +147,9 @@ contains
       end if
     end if
 
-    open (newunit=u, file=path, status='replace', action='write', form='formatted', iostat=ios, iomsg=msg)
+    ! written to path.part, renamed when complete (stream: close_complete checks the size)
+    open (newunit=u, file=path//'.part', status='replace', action='write', form='formatted', &
+          access='stream', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       call fatal_error(err, path // ": cannot open for writing: " // trim(msg))
       return
@@ -192,11 +195,16 @@ contains
     if (ios == 0) write (u, '(a)', iostat=ios, iomsg=msg) '$EndElements'
     if (ios /= 0) then
       call fatal_error(err, path // ": write failed: " // trim(msg))
-      close (u, iostat=ios)
+      close (u, status='delete', iostat=ios)
       return
     end if
-    close (u, iostat=ios, iomsg=msg)
-    if (ios /= 0) call fatal_error(err, path // ": close failed: " // trim(msg))
+    if (.not. close_complete(u, path//'.part')) then
+      call delete_file(path//'.part')
+      call fatal_error(err, path // ": write failed (is the disk full?)")
+    else if (.not. rename_file(path//'.part', path)) then
+      call delete_file(path//'.part')
+      call fatal_error(err, path // ": cannot rename " // path // ".part onto it")
+    end if
   end subroutine write_gmsh
 
   ! ---------------------------------------------------------------------------------------------
