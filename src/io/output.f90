@@ -3,6 +3,7 @@
 !>   history.dat + history.h5     one row per step: energies, momenta, contacts, tracked nodes
 !>   tracked.txt                  a label per tracked node (for the plots)
 module casca_output
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof, element_dofs
@@ -259,6 +260,10 @@ contains
     character(len=32) :: name
     integer :: n, e, b
     if (.not. is_root()) return
+    if (.not. (all(ieee_is_finite(st%q)) .and. all(ieee_is_finite(st%qd)))) then
+      call fatal_error(err, 'the state at step '//itoa(st%step)//' is not finite; no frame written')
+      return
+    end if
     allocate (x(3, model%nnode), u(3, model%nnode), v(3, model%nnode), g(3, model%nnode), &
               a(1, model%nnode), body(1, model%nelem), vm(1, model%nelem))
     do n = 1, model%nnode
