@@ -5,7 +5,7 @@ program casca
   use, intrinsic :: iso_c_binding, only: c_int
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_mpi, only: mpi_start, mpi_stop, is_root
+  use casca_mpi, only: mpi_start, mpi_stop, is_root, max_all
   use casca_run, only: run_deck, load_scene, exit_ok, exit_input
   use casca_deck, only: deck_t
   use casca_model, only: model_t
@@ -48,6 +48,7 @@ program casca
     if (is_root()) write (0, '(a)') 'error: unknown command "'//cmd//'" (see casca --help)'
     code = exit_input
   end select
+  call max_all(code)   ! an error seen on one rank only (casca mesh, casca plot) ends all alike
   call mpi_stop()
   call c_exit(int(code, c_int))   ! a plain exit code, no "STOP n" line, no backtrace
 

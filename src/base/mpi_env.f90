@@ -2,7 +2,7 @@
 !> and the few collectives casca uses.
 module casca_mpi
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_SUM, &
-                     MPI_MIN, MPI_CHARACTER, mpi_init, mpi_finalize, mpi_comm_rank, &
+                     MPI_MIN, MPI_MAX, MPI_CHARACTER, mpi_init, mpi_finalize, mpi_comm_rank, &
                      mpi_comm_size, mpi_initialized, mpi_finalized, mpi_wtime, mpi_allreduce, &
                      mpi_bcast, mpi_comm_split, mpi_comm_free
   use casca_kinds, only: dp
@@ -10,7 +10,7 @@ module casca_mpi
   implicit none
   private
   public :: mpi_start, mpi_stop, comm, comm_handle, group_handle, my_rank, n_ranks, is_root
-  public :: wall_time, sum_all, bcast_real, bcast_int, share_error
+  public :: wall_time, sum_all, bcast_real, bcast_int, share_error, max_all
 
   type(MPI_Comm), protected :: comm
   integer, protected :: my_rank = 0
@@ -129,6 +129,15 @@ contains
     call mpi_allreduce(x, y, size(x), MPI_DOUBLE_PRECISION, MPI_SUM, comm, ierr)
     x = y
   end subroutine sum_all_r2
+
+  !> The largest x of all ranks, on every rank (the exit code: all ranks end with the same).
+  subroutine max_all(x)
+    integer, intent(inout) :: x
+    integer :: y(1), ierr
+    if (n_ranks == 1) return
+    call mpi_allreduce([x], y, 1, MPI_INTEGER, MPI_MAX, comm, ierr)
+    x = y(1)
+  end subroutine max_all
 
   subroutine sum_all_i0(x)
     integer, intent(inout) :: x

@@ -13,14 +13,15 @@ module casca_run
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
   use casca_accounting, only: balance_t, account, gravity_load
-  use casca_output, only: output_t, output_open, output_history, output_frame, output_close
+  use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
+                          output_flush, output_release
   use casca_vtu_writer, only: field_t, field
   use casca_contact, only: contact_t, contact_init, contact_force_total, contact_nodal_fields, &
                            contact_penetration, contact_signed_distance, contact_update
-  use casca_hdf5_io, only: write_checkpoint, read_checkpoint
+  use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
   use casca_free_flight, only: idle_bodies, advance_idle
-  use casca_mpi, only: is_root, wall_time, n_ranks
+  use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   implicit none
   private
@@ -95,8 +96,7 @@ contains
     type(error_t), allocatable :: err
     real(dp), allocatable :: fext(:), fgrav(:), q0(:), q_before(:), qd_before(:)
     logical, allocatable :: frozen(:), idle(:)
-    integer, allocatable :: tracked(:), ints(:)
-    real(dp), allocatable :: reals(:)
+    integer, allocatable :: tracked(:)
     character(len=128), allocatable :: labels(:)
     character(len=:), allocatable :: dir
     real(dp) :: interval, next_frame, next_ckpt, t0, t_start, dt
@@ -133,28 +133,15 @@ contains
     call reference_state(model, q0)
 
     level = 0; restart_step = -1
-    if (restart /= '') then
-      call read_checkpoint(restart, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err)
-      if (allocated(err)) then
-        if (is_root()) write (0, '(a,a)') 'error: ', err%message
-        code = exit_input; return
+    if (restart /= '') then   ! (statics: t is the load factor, <= 1)
+      if (use_contact) then
+        call load_checkpoint(restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
+                             'static'), deck%run%max_step_cuts, st, level, err, contact)
+      else
+        call load_checkpoint(restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
+                             'static'), deck%run%max_step_cuts, st, level, err)
       end if
-      if (size(st%q) /= model%ndof) then
-        if (is_root()) write (0, '(a)') 'error: '//trim(restart)// &
-          ': the checkpoint does not belong to this deck (different number of parameters)'
-        code = exit_input; return
-      end if
-      if (size(ints) >= 1) level = ints(1)
-      if (use_contact .and. size(ints) >= 2) then   ! the active set: (node, pair) per constraint
-        contact%nact = ints(2)
-        if (size(contact%act) < contact%nact) deallocate (contact%act)
-        if (.not. allocated(contact%act)) allocate (contact%act(contact%nact))
-        do k = 1, contact%nact
-          contact%act(k)%node = ints(1 + 2*k); contact%act(k)%pair = ints(2 + 2*k)
-          contact%act(k)%elem = 0
-          contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
-        end do
-      end if
+      if (failed('restart')) return
       restart_step = st%step
     end if
     call output_open(out, dir, tracked, labels, restart_step, st%t, err)
@@ -330,11 +317,13 @@ contains
 
     logical function failed(what)
       character(len=*), intent(in) :: what
+      call share_error(err)   ! collective: every rank stops with the same code
       failed = allocated(err)
       if (failed) then
         if (is_root()) write (0, '(a,a,a,a)') 'error (', what, '): ', err%message
         code = exit_solver
-        if (what == 'output' .or. what == 'setup') code = exit_input
+        if (what == 'output' .or. what == 'setup' .or. what == 'restart') code = exit_input
+        call output_release(out)
       end if
     end function failed
 
@@ -350,19 +339,17 @@ contains
     subroutine checkpoint()
       type(error_t), allocatable :: e
       call ls%drop_factors()   ! on every rank: a restart from here starts with new factors
-      if (.not. is_root()) return
-      if (use_contact) then
-        call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, &
-                              [level, contact%nact, (contact%act(k)%node, contact%act(k)%pair, &
-                                                     k=1, contact%nact)], &
-                              contact%act(1:contact%nact)%lambda, e)
-      else
-        call write_checkpoint(dir//'/checkpoint.h5', st%t, st%step, st%q, st%qd, st%qdd, [level], &
-                              [real(dp) ::], e)
+      call output_flush(out, e)   ! the history up to this step, for a restart from here
+      if (.not. allocated(e) .and. use_contact) then
+        call save_checkpoint(dir//'/checkpoint.h5', model, st, level, contact, e)
+      else if (.not. allocated(e)) then
+        call save_checkpoint(dir//'/checkpoint.h5', model, st, level, err=e)
       end if
+      call share_error(e)
       if (allocated(e)) then
-        write (0, '(a,a)') 'error (checkpoint): ', e%message
+        if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message
         code = exit_solver
+        call output_release(out)
       end if
     end subroutine checkpoint
 
@@ -374,6 +361,7 @@ contains
         ' s: ', why
       call frame()
       call checkpoint()
+      call ls%finish()
       call output_close(out, e)
       if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
         '/checkpoint.h5 (restart with --restart) and in the last frame of '//dir//'/run.pvd'
@@ -382,7 +370,9 @@ contains
 
     subroutine finish()
       type(error_t), allocatable :: e
+      call ls%finish()
       call output_close(out, e)
+      call share_error(e)
       if (allocated(e)) then
         if (is_root()) write (0, '(a,a)') 'error (output): ', e%message
         code = exit_solver; return

@@ -8,7 +8,8 @@
 !> Every problem found while reading is collected (file:line: group: message) so that the
 !> user sees them all at once; nothing here stops the program.
 module casca_deck
-  use, intrinsic :: iso_fortran_env, only: iostat_end
+  use, intrinsic :: iso_fortran_env, only: iostat_end, iostat_eor
+  use casca_files, only: file_kind, kind_special, kind_folder
   use casca_kinds, only: dp
   use casca_deck_lint, only: lint_group, lower
   implicit none
@@ -19,6 +20,11 @@ module casca_deck
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
   integer, parameter :: max_set = 512            !< nodes listed in one restraint or load
+  !> Strings are read into buffers this long and refused if longer than their field (a name
+  !> cut short would silently name another folder or body); lines longer than max_line_len
+  !> are refused (the checks of deck_lint would read them cut).
+  integer, parameter :: long = 1024
+  integer, parameter :: max_line_len = 4096
   real(dp), parameter :: unset = -huge(1._dp)   !< marks a value the deck did not give
   character(len=*), parameter :: known_groups(7) = &
     [character(len=9) :: 'run', 'output', 'body', 'restraint', 'load', 'contact', 'end']
@@ -36,6 +42,7 @@ module casca_deck
     logical :: skip_idle_bodies = .true.        !< advance bodies in free flight without solving
     real(dp) :: gravity(3) = 0
     character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
+    integer :: line = 0
   end type run_cfg_t
 
   type :: output_cfg_t
@@ -47,6 +54,7 @@ module casca_deck
     integer :: ntrack = 0
     real(dp) :: track(3, max_track) = 0         !< tracked nodes: nearest to these points
     character(len=64) :: track_body(max_track) = ''
+    integer :: line = 0
   end type output_cfg_t
 
   type :: body_cfg_t
@@ -137,6 +145,22 @@ contains
     end if
   end subroutine add_problem
 
+  !> dest = text, or a problem naming the field if text does not fit in dest
+  subroutine take(deck, line, field, text, dest)
+    type(deck_t), intent(inout) :: deck
+    integer, intent(in) :: line
+    character(len=*), intent(in) :: field, text
+    character(len=*), intent(inout) :: dest
+    character(len=16) :: n
+    if (len_trim(text) > len(dest)) then
+      write (n, '(i0)') len(dest)
+      call add_problem(deck, line, field//' is longer than '//trim(n)//' characters ("'// &
+                       text(1:20)//'...")')
+    else
+      dest = text
+    end if
+  end subroutine take
+
   !> Read every group of the deck at path. Problems go to deck%problems.
   subroutine read_deck(path, deck)
     character(len=*), intent(in) :: path
@@ -150,6 +174,10 @@ contains
     k = index(path, '/', back=.true.)
     deck%base_dir = path(1:k)
     allocate (deck%bodies(0), deck%restraints(0), deck%loads(0))
+    if (file_kind(path) == kind_special .or. file_kind(path) == kind_folder) then
+      call add_problem(deck, 0, 'the deck is not a regular file (a folder, FIFO or device)')
+      return
+    end if
     open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       call add_problem(deck, 0, 'cannot open the deck: '//trim(msg))
@@ -193,9 +221,7 @@ contains
     subroutine read_bodies(uu, dk)
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
-      character(len=64) :: name
-      character(len=16) :: mesh
-      character(len=256) :: file
+      character(len=long) :: name, mesh, file
       real(dp) :: radius, width, lx, ly, center(3), young, poisson, density, thickness
       real(dp) :: rotate_axis(3), rotate_angle
       real(dp) :: velocity(3), omega(3)
@@ -216,12 +242,15 @@ contains
           call add_problem(dk, line_of('body', ib), '&body: '//trim(msg))
           return
         end if
-        b%name = name; b%mesh = mesh; b%file = file; b%radius = radius; b%width = width
+        b%line = line_of('body', ib)
+        call take(dk, b%line, '&body: name', name, b%name)
+        call take(dk, b%line, '&body: mesh', mesh, b%mesh)
+        call take(dk, b%line, '&body: file', file, b%file)
+        b%radius = radius; b%width = width
         b%lx = lx; b%ly = ly; b%n_around = n_around; b%n_across = n_across; b%n_div = n_div
         b%nx = nx; b%ny = ny; b%center = center; b%young = young; b%poisson = poisson
         b%density = density; b%thickness = thickness; b%velocity = velocity; b%omega = omega
         b%rotate_axis = rotate_axis; b%rotate_angle = rotate_angle
-        b%line = line_of('body', ib)
         dk%bodies = [dk%bodies, b]
       end do
     end subroutine read_bodies
@@ -229,7 +258,7 @@ contains
     subroutine read_restraints(uu, dk)
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
-      character(len=64) :: body, fix
+      character(len=long) :: body, fix
       real(dp) :: box_min(3), box_max(3)
       integer :: nodes(max_set)
       namelist /restraint/ body, box_min, box_max, fix, nodes
@@ -244,9 +273,11 @@ contains
           call add_problem(dk, line_of('restraint', ir), '&restraint: '//trim(msg))
           return
         end if
-        r%body = body; r%fix = fix; r%box_min = box_min; r%box_max = box_max
-        r%nodes = pack(nodes, nodes /= 0)
         r%line = line_of('restraint', ir)
+        call take(dk, r%line, '&restraint: body', body, r%body)
+        call take(dk, r%line, '&restraint: fix', fix, r%fix)
+        r%box_min = box_min; r%box_max = box_max
+        r%nodes = pack(nodes, nodes /= 0)
         dk%restraints = [dk%restraints, r]
       end do
     end subroutine read_restraints
@@ -254,7 +285,7 @@ contains
     subroutine read_loads(uu, dk)
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
-      character(len=64) :: body
+      character(len=long) :: body
       real(dp) :: box_min(3), box_max(3), force(3)
       integer :: nodes(max_set)
       namelist /load/ body, box_min, box_max, force, nodes
@@ -269,9 +300,10 @@ contains
           call add_problem(dk, line_of('load', il), '&load: '//trim(msg))
           return
         end if
-        l%body = body; l%box_min = box_min; l%box_max = box_max; l%force = force
-        l%nodes = pack(nodes, nodes /= 0)
         l%line = line_of('load', il)
+        call take(dk, l%line, '&load: body', body, l%body)
+        l%box_min = box_min; l%box_max = box_max; l%force = force
+        l%nodes = pack(nodes, nodes /= 0)
         dk%loads = [dk%loads, l]
       end do
     end subroutine read_loads
@@ -284,19 +316,23 @@ contains
     type(deck_t), intent(inout) :: deck
     character(len=16), allocatable, intent(out) :: gname(:)
     integer, allocatable, intent(out) :: gline(:)
-    character(len=1024) :: line
-    character(len=1024), allocatable :: text(:)
+    character(len=max_line_len) :: line
+    character(len=max_line_len), allocatable :: text(:)
     character(len=16) :: name
-    integer :: ios, n, j, k
+    integer :: ios, n, j, k, nread
     integer, allocatable :: lines(:)
     character(len=512), allocatable :: msgs(:)
 
     allocate (gname(0), gline(0), text(0))
     n = 0
     do
-      read (u, '(a)', iostat=ios) line
+      read (u, '(a)', advance='no', size=nread, iostat=ios) line
       if (ios == iostat_end) exit
-      if (ios /= 0) then
+      if (ios == 0) then   ! no end of line within the buffer
+        write (name, '(i0)') max_line_len
+        call add_problem(deck, n + 1, 'line longer than '//trim(name)//' characters')
+        read (u, '(a)', iostat=ios)   ! (the rest of it)
+      else if (ios /= iostat_eor) then
         call add_problem(deck, n + 1, 'unreadable line'); exit
       end if
       n = n + 1
@@ -326,8 +362,7 @@ contains
   subroutine read_run(u, deck, line)
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
-    character(len=128) :: title
-    character(len=16) :: analysis, ordering
+    character(len=long) :: title, analysis, ordering
     real(dp) :: dt, t_end, beta, gamma, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
     logical :: reuse_factorisation, skip_idle_bodies
@@ -340,16 +375,20 @@ contains
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
       ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
       skip_idle_bodies = c%skip_idle_bodies
+      c%line = line
       if (line == 0) return
       rewind (u)
       read (u, nml=run, iostat=ios, iomsg=msg)
       if (ios /= 0) then
         call add_problem(deck, line, '&run: '//trim(msg)); return
       end if
-      c%title = title; c%analysis = lower(analysis); c%dt = dt; c%t_end = t_end; c%beta = beta
+      call take(deck, line, '&run: title', title, c%title)
+      call take(deck, line, '&run: analysis', lower(analysis), c%analysis)
+      call take(deck, line, '&run: ordering', lower(ordering), c%ordering)
+      c%dt = dt; c%t_end = t_end; c%beta = beta
       c%gamma = gamma; c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
-      c%ordering = lower(ordering); c%reuse_factorisation = reuse_factorisation
+      c%reuse_factorisation = reuse_factorisation
       c%skip_idle_bodies = skip_idle_bodies
     end associate
   end subroutine read_run
@@ -357,9 +396,9 @@ contains
   subroutine read_output(u, deck, line)
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
-    character(len=256) :: dir, msg
+    character(len=long) :: dir, track_body(max_track)
+    character(len=256) :: msg
     real(dp) :: interval, checkpoint_interval, track(3, max_track)
-    character(len=64) :: track_body(max_track)
     logical :: vtu, plots
     integer :: ios, k
     namelist /output/ dir, interval, vtu, plots, checkpoint_interval, track, track_body
@@ -367,20 +406,25 @@ contains
       dir = c%dir; interval = c%interval; vtu = c%vtu; plots = c%plots
       checkpoint_interval = c%checkpoint_interval
       track = unset; track_body = ''
+      c%line = line
       if (line == 0) return
       rewind (u)
       read (u, nml=output, iostat=ios, iomsg=msg)
       if (ios /= 0) then
         call add_problem(deck, line, '&output: '//trim(msg)); return
       end if
-      c%dir = dir; c%interval = interval; c%vtu = vtu; c%plots = plots
+      call take(deck, line, '&output: dir', dir, c%dir)
+      do k = 1, max_track
+        call take(deck, line, '&output: track_body', track_body(k), c%track_body(k))
+      end do
+      c%interval = interval; c%vtu = vtu; c%plots = plots
       c%checkpoint_interval = checkpoint_interval
       c%ntrack = 0
       do k = 1, max_track
         if (any(track(:, k) == unset)) exit
         c%ntrack = k
       end do
-      c%track = track; c%track_body = track_body
+      c%track = track
       if (c%ntrack < max_track) then
         if (any(track(:, c%ntrack + 1) /= unset)) &
           call add_problem(deck, line, '&output: track needs 3 coordinates per point')
@@ -392,9 +436,9 @@ contains
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
     logical :: enabled
-    character(len=64) :: pairs(2, max_pairs)
+    character(len=long) :: solver, normal
+    character(len=256) :: pairs(2, max_pairs)   ! (longer than a name: enough to see one too long)
     real(dp) :: tolerance
-    character(len=16) :: solver, normal
     character(len=256) :: msg
     integer :: ios, k
     namelist /contact/ enabled, pairs, tolerance, solver, normal
@@ -407,12 +451,15 @@ contains
       if (ios /= 0) then
         call add_problem(deck, line, '&contact: '//trim(msg)); return
       end if
-      c%enabled = enabled; c%tolerance = tolerance; c%pairs = pairs; c%solver = lower(solver)
-      c%normal = lower(normal)
+      c%enabled = enabled; c%tolerance = tolerance
+      call take(deck, line, '&contact: solver', lower(solver), c%solver)
+      call take(deck, line, '&contact: normal', lower(normal), c%normal)
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit
         c%npairs = k
+        call take(deck, line, '&contact: pairs', pairs(1, k), c%pairs(1, k))
+        call take(deck, line, '&contact: pairs', pairs(2, k), c%pairs(2, k))
         if (pairs(1, k) == '' .or. pairs(2, k) == '') &
           call add_problem(deck, line, '&contact: pairs needs two body names per pair')
       end do

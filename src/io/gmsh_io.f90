@@ -7,11 +7,16 @@ module casca_gmsh_io
   use casca_kinds, only: dp, i8
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
+  use casca_files, only: file_kind, kind_folder, kind_special, kind_regular, close_complete, &
+                         delete_file, rename_file
+  use, intrinsic :: iso_fortran_env, only: int64
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   implicit none
   private
   public :: read_gmsh, write_gmsh
 
   integer, parameter :: tri10_type = 21
+  real(dp), parameter :: max_coordinate = 1e15_dp   !< [m]: far beyond any scene, far below overflow
 
   !> Position in the in-memory file: the next line starts at buf(pos:); `line` is the number of
   !> the line last returned (0 before the first).
@@ -142,7 +147,9 @@ contains
       end if
     end if
 
-    open (newunit=u, file=path, status='replace', action='write', form='formatted', iostat=ios, iomsg=msg)
+    ! written to path.part, renamed when complete (stream: close_complete checks the size)
+    open (newunit=u, file=path//'.part', status='replace', action='write', form='formatted', &
+          access='stream', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       call fatal_error(err, path // ": cannot open for writing: " // trim(msg))
       return
@@ -188,11 +195,16 @@ contains
     if (ios == 0) write (u, '(a)', iostat=ios, iomsg=msg) '$EndElements'
     if (ios /= 0) then
       call fatal_error(err, path // ": write failed: " // trim(msg))
-      close (u, iostat=ios)
+      close (u, status='delete', iostat=ios)
       return
     end if
-    close (u, iostat=ios, iomsg=msg)
-    if (ios /= 0) call fatal_error(err, path // ": close failed: " // trim(msg))
+    if (.not. close_complete(u, path//'.part')) then
+      call delete_file(path//'.part')
+      call fatal_error(err, path // ": write failed (is the disk full?)")
+    else if (.not. rename_file(path//'.part', path)) then
+      call delete_file(path//'.part')
+      call fatal_error(err, path // ": cannot rename " // path // ".part onto it")
+    end if
   end subroutine write_gmsh
 
   ! ---------------------------------------------------------------------------------------------
@@ -285,6 +297,8 @@ contains
           call fail(err, cur, "expected 3 node coordinates 'x y z', found '" // clip(cur%buf(s:e)) // "'")
           return
         end if
+        call check_coordinates(cur, raw%x(:, first + k), err)
+        if (allocated(err)) return
       end do
       raw%nnode = first + nin
     end do
@@ -317,6 +331,8 @@ contains
         call fail(err, cur, "expected 'node-tag x y z', found '" // clip(cur%buf(s:e)) // "'")
         return
       end if
+      call check_coordinates(cur, raw%x(:, k), err)
+      if (allocated(err)) return
       raw%node_line(k) = cur%line
     end do
     raw%nnode = n
@@ -494,15 +510,36 @@ contains
   ! ---------------------------------------------------------------------------------------------
   ! Helpers
 
+  !> Coordinates on the current line must be finite and below max_coordinate in size (a NaN,
+  !> an Inf or 1e308 would pass every later check)
+  subroutine check_coordinates(cur, x, err)
+    type(cursor_t), intent(inout) :: cur
+    real(dp), intent(in) :: x(3)
+    type(error_t), allocatable, intent(out) :: err
+    if (.not. all(ieee_is_finite(x) .and. abs(x) <= max_coordinate)) &
+      call fail(err, cur, "node coordinates must be finite numbers of size below 1e15 m")
+  end subroutine check_coordinates
+
   !> Read the whole file as bytes (stream access never trips over line-ending quirks).
   subroutine load_file(path, cur, err)
     character(len=*), intent(in) :: path
     type(cursor_t), intent(out) :: cur
     type(error_t), allocatable, intent(out) :: err
     integer :: u, ios, nbytes
+    integer(int64) :: size
     character(len=512) :: msg
 
     cur%path = path
+    select case (file_kind(path, size))   ! a FIFO would block the read forever
+    case (kind_folder, kind_special)
+      call fatal_error(err, path // ": not a regular file (a folder, FIFO or device)")
+      return
+    case (kind_regular)
+      if (size > huge(nbytes)) then
+        call fatal_error(err, path // ": larger than 2 GiB; meshes are read up to 2 GiB")
+        return
+      end if
+    end select
     open (newunit=u, file=path, status='old', action='read', access='stream', form='unformatted', &
           iostat=ios, iomsg=msg)
     if (ios /= 0) then

@@ -12,14 +12,20 @@
 !> unlimited and chunked, so Python (h5py, numpy C order) sees shape (nrow, ncol); its
 !> attribute "columns" holds the column names as fixed-length, null-padded ASCII strings
 !> (h5py returns a numpy array of bytes). Rows are extended and written one at a time; the
-!> file is flushed to disk only by h5_table_flush (and close).
+!> file is flushed to disk only by h5_table_flush (and close). A table made in_memory lives in
+!> memory (HDF5's core driver) and h5_table_flush writes its image whole, to <path>.part
+!> renamed onto <path>: the file on disk is always complete, and a full disk is an error
+!> returned here (HDF5 itself, failing to write, leaves a file it cannot close and crashes
+!> when the library shuts down).
 !>
 !> Checkpoint layout: scalar datasets "/t" (float64), "/step" and "/ndof" (int32), 1-D
-!> datasets "/q", "/qd", "/qdd" (float64, ndof), "/ints" (int32) and "/reals" (float64), both possibly empty. It is
-!> written to <path>.part and renamed onto <path> only when complete and closed, so a crash
-!> while writing never replaces a good checkpoint (rename(2) is atomic on one file system).
+!> datasets "/q", "/qd", "/qdd" (float64, ndof), "/ints" (int32) and "/reals" (float64), both possibly empty,
+!> and "/fingerprint" (int32) when the caller gives one (the model's: casca_checkpoint). It is
+!> made in memory and its image written to <path>.part, renamed onto <path> only when complete
+!> and closed, so a crash or a full disk while writing never replaces a good checkpoint
+!> (rename(2) is atomic on one file system).
 module casca_hdf5_io
-  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+  use, intrinsic :: iso_c_binding, only: c_char, c_ptr, c_null_ptr, c_loc
   use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5fcreate_f, h5fopen_f, &
                   h5fclose_f, h5fflush_f, h5fis_hdf5_f, H5F_ACC_TRUNC_F, H5F_ACC_RDWR_F, &
                   H5F_ACC_RDONLY_F, H5F_SCOPE_GLOBAL_F, h5screate_f, h5screate_simple_f, &
@@ -30,10 +36,11 @@ module casca_hdf5_io
                   H5P_DATASET_CREATE_F, h5acreate_f, h5awrite_f, h5aclose_f, h5tcopy_f, &
                   h5tset_size_f, h5tset_strpad_f, h5tclose_f, H5T_NATIVE_CHARACTER, &
                   H5T_STR_NULLPAD_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_IEEE_F64LE, &
-                  H5T_STD_I32LE, h5lexists_f
+                  H5T_STD_I32LE, h5lexists_f, H5P_FILE_ACCESS_F, h5pset_fapl_core_f, &
+                  h5fget_file_image_f
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_files, only: rename_file, delete_file
+  use casca_checked_file, only: write_file_atomic
   implicit none
   private
   public :: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, h5_table_close, &
@@ -49,6 +56,7 @@ module casca_hdf5_io
     integer(hsize_t) :: nrow = 0
     character(len=:), allocatable :: path
     logical :: is_open = .false.
+    logical :: in_memory = .false.          !< flushed as a whole image (see above)
   end type h5_table_t
 
   character(len=*), parameter :: table_dset = 'history'
@@ -67,11 +75,12 @@ contains
 
   !> Create (or overwrite) path with an empty table whose columns are named columns(:)
   !> (trailing blanks are not stored). tab must not be open.
-  subroutine h5_table_create(tab, path, columns, err)
+  subroutine h5_table_create(tab, path, columns, err, in_memory)
     type(h5_table_t), intent(inout) :: tab
     character(len=*), intent(in) :: path
     character(len=*), intent(in) :: columns(:)
     type(error_t), allocatable, intent(out) :: err
+    logical, intent(in), optional :: in_memory
 
     character(len=*), parameter :: who = 'h5_table_create'
     integer(hid_t) :: fid, space, plist, dset, strtype, aspace, attr, memspace
@@ -90,11 +99,10 @@ contains
     call ensure_open(who, path, err)
     if (allocated(err)) return
 
-    call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, h)
-    if (h /= 0) then
-      call fatal_error(err, who//': cannot create HDF5 file '//path)
-      return
-    end if
+    tab%in_memory = .false.
+    if (present(in_memory)) tab%in_memory = in_memory
+    call create_file(who, path, tab%in_memory, fid, err)
+    if (allocated(err)) return
 
     dims = [int(ncol, hsize_t), 0_hsize_t]
     maxdims = [int(ncol, hsize_t), H5S_UNLIMITED_F]
@@ -281,6 +289,10 @@ contains
       call fatal_error(err, 'h5_table_flush: the table is not open')
       return
     end if
+    if (tab%in_memory) then
+      call save_image('h5_table_flush', tab%path, tab%file, err)
+      return
+    end if
     call h5fflush_f(tab%file, H5F_SCOPE_GLOBAL_F, h)
     if (h /= 0) call fatal_error(err, 'h5_table_flush: '//tab%path//': flush failed')
   end subroutine h5_table_flush
@@ -292,10 +304,11 @@ contains
     integer :: h1, h2, h3
 
     if (.not. tab%is_open) return
+    if (tab%in_memory) call save_image('h5_table_close', tab%path, tab%file, err)
     call h5sclose_f(tab%memspace, h1)
     call h5dclose_f(tab%dset, h2)
     call h5fclose_f(tab%file, h3)
-    if (h1 /= 0 .or. h2 /= 0 .or. h3 /= 0) &
+    if ((h1 /= 0 .or. h2 /= 0 .or. h3 /= 0) .and. .not. allocated(err)) &
       call fatal_error(err, 'h5_table_close: '//tab%path//': error closing the file')
     tab%file = -1
     tab%dset = -1
@@ -318,7 +331,7 @@ contains
   !> Write a restart checkpoint to path (via path.part, renamed when complete).
   !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
   !> have any size, including 0.
-  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err)
+  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
@@ -326,9 +339,9 @@ contains
     integer, intent(in) :: ints(:)
     real(dp), intent(in) :: reals(:)
     type(error_t), allocatable, intent(out) :: err
+    integer, intent(in), optional :: fingerprint(:)
 
     character(len=*), parameter :: who = 'write_checkpoint'
-    character(len=:), allocatable :: tmp
     integer(hid_t) :: fid
     integer :: h
 
@@ -341,39 +354,24 @@ contains
     call ensure_open(who, path, err)
     if (allocated(err)) return
 
-    tmp = path//'.part'
-    call h5fcreate_f(tmp, H5F_ACC_TRUNC_F, fid, h)
-    if (h /= 0) then
-      call fatal_error(err, who//': cannot create HDF5 file '//tmp)
-      return
-    end if
-    call put_real_scalar(who, tmp, fid, 't', t, err)
-    if (.not. allocated(err)) call put_int_scalar(who, tmp, fid, 'step', step, err)
-    if (.not. allocated(err)) call put_int_scalar(who, tmp, fid, 'ndof', size(q), err)
-    if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'q', q, err)
-    if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'qd', qd, err)
-    if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'qdd', qdd, err)
-    if (.not. allocated(err)) call put_int_1d(who, tmp, fid, 'ints', ints, err)
-    if (.not. allocated(err)) call put_real_1d(who, tmp, fid, 'reals', reals, err)
-    call h5fclose_f(fid, h)
-    if (allocated(err)) then
-      call delete_file(tmp)
-      return
-    end if
-    if (h /= 0) then
-      call fatal_error(err, who//': error closing '//tmp)
-      call delete_file(tmp)
-      return
-    end if
-    if (.not. rename_file(tmp, path)) then
-      call fatal_error(err, who//': cannot rename '//tmp//' to '//path)
-      call delete_file(tmp)
-      return
-    end if
+    call create_file(who, path, .true., fid, err)
+    if (allocated(err)) return
+    call put_real_scalar(who, path, fid, 't', t, err)
+    if (.not. allocated(err)) call put_int_scalar(who, path, fid, 'step', step, err)
+    if (.not. allocated(err)) call put_int_scalar(who, path, fid, 'ndof', size(q), err)
+    if (.not. allocated(err)) call put_real_1d(who, path, fid, 'q', q, err)
+    if (.not. allocated(err)) call put_real_1d(who, path, fid, 'qd', qd, err)
+    if (.not. allocated(err)) call put_real_1d(who, path, fid, 'qdd', qdd, err)
+    if (.not. allocated(err)) call put_int_1d(who, path, fid, 'ints', ints, err)
+    if (.not. allocated(err)) call put_real_1d(who, path, fid, 'reals', reals, err)
+    if (present(fingerprint) .and. .not. allocated(err)) &
+      call put_int_1d(who, path, fid, 'fingerprint', fingerprint, err)
+    if (.not. allocated(err)) call save_image(who, path, fid, err)
+    call h5fclose_f(fid, h)   ! (in memory: nothing to fail on)
   end subroutine write_checkpoint
 
-  !> Read a checkpoint written by write_checkpoint.
-  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err)
+  !> Read a checkpoint written by write_checkpoint (fingerprint: not allocated if it has none).
+  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
@@ -381,10 +379,12 @@ contains
     integer, allocatable, intent(out) :: ints(:)
     real(dp), allocatable, intent(out) :: reals(:)
     type(error_t), allocatable, intent(out) :: err
+    integer, allocatable, intent(out), optional :: fingerprint(:)
 
     character(len=*), parameter :: who = 'read_checkpoint'
     integer(hid_t) :: fid
     integer :: ndof, h
+    logical :: has_fp
 
     t = 0
     step = 0
@@ -398,6 +398,10 @@ contains
     if (.not. allocated(err)) call get_real_1d(who, path, fid, 'qdd', qdd, err)
     if (.not. allocated(err)) call get_int_1d(who, path, fid, 'ints', ints, err)
     if (.not. allocated(err)) call get_real_1d(who, path, fid, 'reals', reals, err)
+    if (present(fingerprint) .and. .not. allocated(err)) then
+      call h5lexists_f(fid, 'fingerprint', has_fp, h)
+      if (h == 0 .and. has_fp) call get_int_1d(who, path, fid, 'fingerprint', fingerprint, err)
+    end if
     call h5fclose_f(fid, h)
     if (allocated(err)) return
     if (size(q) /= ndof .or. size(qd) /= ndof .or. size(qdd) /= ndof) then
@@ -412,6 +416,50 @@ contains
   ! ---------------------------------------------------------------------------------------
   ! Helpers
   ! ---------------------------------------------------------------------------------------
+
+  !> Create the HDF5 file path: on disk, or in memory only (core driver, no backing store:
+  !> save_image writes it).
+  subroutine create_file(who, path, in_memory, fid, err)
+    character(len=*), intent(in) :: who, path
+    logical, intent(in) :: in_memory
+    integer(hid_t), intent(out) :: fid
+    type(error_t), allocatable, intent(out) :: err
+    integer(hid_t) :: fapl
+    integer :: h, i
+    if (in_memory) then
+      call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, h)
+      if (h == 0) call h5pset_fapl_core_f(fapl, int(1048576, size_t), .false., h)
+      if (h == 0) call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, h, access_prp=fapl)
+      call h5pclose_f(fapl, i)
+    else
+      call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, h)
+    end if
+    if (h /= 0) call fatal_error(err, who//': cannot create HDF5 file '//path)
+  end subroutine create_file
+
+  !> Write the image of the in-memory file fid to path (via path.part, renamed when complete).
+  subroutine save_image(who, path, fid, err)
+    character(len=*), intent(in) :: who, path
+    integer(hid_t), intent(in) :: fid
+    type(error_t), allocatable, intent(out) :: err
+    character(kind=c_char), allocatable, target :: image(:)
+    type(c_ptr) :: buf
+    integer(size_t) :: n
+    integer :: h
+    buf = c_null_ptr
+    call h5fflush_f(fid, H5F_SCOPE_GLOBAL_F, h)   ! the image holds only flushed metadata
+    if (h == 0) call h5fget_file_image_f(fid, buf, 0_size_t, h, n)
+    if (h == 0) then
+      allocate (image(n))
+      buf = c_loc(image)
+      call h5fget_file_image_f(fid, buf, n, h)
+    end if
+    if (h /= 0) then
+      call fatal_error(err, who//': '//path//': cannot make the file image'); return
+    end if
+    call write_file_atomic(path, image, err)
+    if (allocated(err)) err%message = who//': '//err%message
+  end subroutine save_image
 
   !> Open the HDF5 library once per run and silence its error-stack printing.
   subroutine ensure_open(who, path, err)
@@ -661,10 +709,14 @@ contains
     if (allocated(err)) return
     call dataset_dims(who, path, dset, name, 1, dims, err)
     if (.not. allocated(err)) then
-      allocate (x(dims(1)))
-      h = 0
-      if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, x, dims, h)
-      if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      allocate (x(dims(1)), stat=h)   ! a damaged file may claim any size
+      if (h /= 0) then
+        allocate (x(0))
+        call too_large(who, path, name, dims(1), err)
+      else
+        if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, x, dims, h)
+        if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      end if
     end if
     call h5dclose_f(dset, i)
   end subroutine get_real_1d
@@ -681,13 +733,26 @@ contains
     if (allocated(err)) return
     call dataset_dims(who, path, dset, name, 1, dims, err)
     if (.not. allocated(err)) then
-      allocate (x(dims(1)))
-      h = 0
-      if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_INTEGER, x, dims, h)
-      if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      allocate (x(dims(1)), stat=h)   ! a damaged file may claim any size
+      if (h /= 0) then
+        allocate (x(0))
+        call too_large(who, path, name, dims(1), err)
+      else
+        if (dims(1) > 0) call h5dread_f(dset, H5T_NATIVE_INTEGER, x, dims, h)
+        if (h /= 0) call fatal_error(err, who//': '//path//': cannot read dataset /'//name)
+      end if
     end if
     call h5dclose_f(dset, i)
   end subroutine get_int_1d
+
+  !> The error of a dataset whose claimed size cannot be allocated
+  subroutine too_large(who, path, name, n, err)
+    character(len=*), intent(in) :: who, path, name
+    integer(hsize_t), intent(in) :: n
+    type(error_t), allocatable, intent(out) :: err
+    call fatal_error(err, who//': '//path//': /'//name//' claims '//itoa(n)// &
+                     ' values, more than fit in memory')
+  end subroutine too_large
 
   !> Close a half-built file after an error (ids of -1 are skipped).
   subroutine abandon(fid, dset)

@@ -14,7 +14,11 @@ module casca_mesh_generators
   use casca_vectors, only: cross
   implicit none
   private
-  public :: mesh_ring, mesh_sphere, mesh_plate
+  public :: mesh_ring, mesh_sphere, mesh_plate, generated_elements
+
+  !> Most elements a generator makes: beyond it the lattice indices (3n+1)^2 leave 32 bits
+  !> and no machine would hold the model anyway
+  real(dp), parameter, public :: max_generated_elements = 1e7_dp
 
   !> Local lattice offsets (in thirds of an element edge, along the element's (xi1, xi2)) of the
   !> ten nodes, in the casca / Gmsh TRI10 order documented in casca_mesh.
@@ -22,6 +26,32 @@ module casca_mesh_generators
   integer, parameter :: node_b(nen) = [0, 0, 3, 0, 0, 1, 2, 2, 1, 1]
 
 contains
+
+  !> Number of elements the generator kind ('ring', 'sphere', 'plate', 'strip') makes from
+  !> its sizes (n1, n2) = (n_around, n_across), (n_div, -) or (nx, ny); in real arithmetic,
+  !> so that absurd sizes are seen before they overflow.
+  pure real(dp) function generated_elements(kind, n1, n2) result(n)
+    character(len=*), intent(in) :: kind
+    integer, intent(in) :: n1, n2
+    select case (kind)
+    case ('sphere')
+      n = 20*real(n1, dp)**2
+    case default
+      n = 2*real(n1, dp)*real(n2, dp)
+    end select
+  end function generated_elements
+
+  !> An error if the generator kind would make more than max_generated_elements
+  subroutine check_count(kind, n1, n2, err)
+    character(len=*), intent(in) :: kind
+    integer, intent(in) :: n1, n2
+    type(error_t), allocatable, intent(out) :: err
+    character(len=24) :: num
+    if (generated_elements(kind, n1, n2) <= max_generated_elements) return
+    write (num, '(es9.2)') generated_elements(kind, n1, n2)
+    call fatal_error(err, 'mesh_'//kind//': the sizes give '//trim(adjustl(num))// &
+                     ' elements, more than the 1e7 a generator makes')
+  end subroutine check_count
 
   !> Cylindrical strip: axis z, mid-surface radius `radius`, z in [-width/2, width/2].
   !> xi1 runs with the angle and xi2 with z, so e_theta x e_z = e_r points outward.
@@ -42,6 +72,8 @@ contains
       call fatal_error(err, "mesh_ring: need n_around >= 3 and n_across >= 1")
       return
     end if
+    call check_count('ring', n_around, n_across, err)
+    if (allocated(err)) return
 
     ni = 3*n_around       ! lattice points around (periodic: index ni is index 0)
     nj = 3*n_across + 1   ! lattice points across
@@ -76,6 +108,8 @@ contains
       call fatal_error(err, "mesh_plate: need nx >= 1 and ny >= 1")
       return
     end if
+    call check_count('plate', nx, ny, err)
+    if (allocated(err)) return
 
     ni = 3*nx + 1
     nj = 3*ny + 1
@@ -156,6 +190,8 @@ contains
       call fatal_error(err, "mesh_sphere: need n_div >= 1")
       return
     end if
+    call check_count('sphere', n_div, 0, err)
+    if (allocated(err)) return
 
     call icosahedron(v, face, edge_of)
     nl = 3*n_div                        ! lattice steps along an icosahedron edge

@@ -3,6 +3,7 @@
 !>   history.dat + history.h5     one row per step: energies, momenta, contacts, tracked nodes
 !>   tracked.txt                  a label per tracked node (for the plots)
 module casca_output
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof, element_dofs
@@ -11,15 +12,21 @@ module casca_output
   use casca_shell_element, only: shell_von_mises
   use casca_vtu_writer, only: field_t, field, write_vtu, write_pvd
   use casca_hdf5_io, only: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, &
-                           h5_table_close, h5_table_open_append
+                           h5_table_close
   use casca_mpi, only: is_root
+  use casca_strings, only: itoa
+  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line
+  use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
+                                cf_discard, write_file_atomic
+  use casca_output_lock, only: lock_folder, unlock_folder
   implicit none
   private
-  public :: output_t, output_open, output_history, output_frame, output_close
+  public :: output_t, output_open, output_history, output_frame, output_close, output_flush, &
+            output_release
 
   type :: output_t
     character(len=:), allocatable :: dir
-    integer :: hist = 0                 !< unit of history.dat (newunit: negative)
+    type(checked_file_t) :: hist        !< history.dat
     logical :: hist_open = .false.
     type(h5_table_t) :: h5
     integer :: nframes = 0
@@ -27,7 +34,10 @@ module casca_output
     real(dp), allocatable :: times(:)
     integer, allocatable :: tracked(:)
     integer :: rows = 0
+    logical :: locked = .false.         !< this run holds the folder's lock
   end type output_t
+
+  integer, parameter :: max_line = 16384   !< longest history.dat line read back at a restart
 
 contains
 
@@ -49,8 +59,9 @@ contains
     end do
   end function history_columns
 
-  !> Create the folder and the files; with restart_step >= 0 keep what an earlier run wrote up
-  !> to that step (and the frames up to restart_time) and append after it.
+  !> Create the folder, lock it (casca_output_lock) and make the files; with restart_step >= 0
+  !> keep what an earlier run wrote up to that step (and the frames up to restart_time) and
+  !> append after it.
   subroutine output_open(out, dir, tracked, labels, restart_step, restart_time, err)
     type(output_t), intent(out) :: out
     character(len=*), intent(in) :: dir
@@ -60,77 +71,37 @@ contains
     real(dp), intent(in) :: restart_time
     type(error_t), allocatable, intent(out) :: err
     character(len=16), allocatable :: cols(:)
-    integer :: u, ios, k, stat
+    character(len=:), allocatable :: note
+    integer :: ios
     character(len=256) :: msg
 
     out%dir = trim(dir)
     out%tracked = tracked
     allocate (out%files(0), out%times(0))
     if (.not. is_root()) return
-    call execute_command_line('mkdir -p "'//out%dir//'"', exitstat=stat, cmdstat=ios)
-    if (ios /= 0 .or. stat /= 0) then
+    if (.not. make_dir(out%dir)) then
       call fatal_error(err, 'cannot create the output folder '//out%dir); return
     end if
+    call lock_folder(out%dir, note, err)
+    if (allocated(err)) return
+    out%locked = .true.
+    if (note /= '') write (0, '(a)') 'warning: '//note
+    call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
+    if (allocated(err)) return
     cols = history_columns(size(tracked))
-    open (newunit=u, file=out%dir//'/tracked.txt', status='replace', iostat=ios, iomsg=msg)
-    if (ios /= 0) then
-      call fatal_error(err, out%dir//'/tracked.txt: '//trim(msg)); return
-    end if
-    do k = 1, size(tracked)
-      write (u, '(a)') trim(labels(k))
-    end do
-    close (u)
     if (restart_step < 0) then
-      open (newunit=out%hist, file=out%dir//'/history.dat', status='replace', iostat=ios, &
-            iomsg=msg)
-      if (ios /= 0) then
-        call fatal_error(err, out%dir//'/history.dat: '//trim(msg)); return
-      end if
-      out%hist_open = .true.
-      write (out%hist, '(a,*(1x,a))') '#', (trim(cols(k)), k=1, size(cols))
-      call h5_table_create(out%h5, out%dir//'/history.h5', cols, err)
-    else
-      call keep_history(restart_step, err)
+      call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return
-      call h5_table_open_append(out%h5, out%dir//'/history.h5', size(cols), out%rows, err)
+      out%hist_open = .true.
+      call cf_write(out%hist, '#'//join(cols, ' ', '')//new_line('a'), err)
+      if (allocated(err)) return
+      call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
+    else
+      call keep_history(out, cols, restart_step, err)
       if (allocated(err)) return
       call keep_frames(restart_time, err)
     end if
   contains
-    !> rewrite history.dat with its header and the rows of steps <= last
-    subroutine keep_history(last, e)
-      integer, intent(in) :: last
-      type(error_t), allocatable, intent(out) :: e
-      character(len=:), allocatable :: line
-      character(len=8192) :: buf
-      character(len=8192), allocatable :: keep(:)
-      real(dp) :: tt, ss
-      integer :: uu, i
-      open (newunit=uu, file=out%dir//'/history.dat', status='old', iostat=ios, iomsg=msg)
-      if (ios /= 0) then
-        call fatal_error(e, 'restart: '//out%dir//'/history.dat: '//trim(msg)); return
-      end if
-      allocate (keep(0))
-      out%rows = 0
-      do
-        read (uu, '(a)', iostat=ios) buf
-        if (ios /= 0) exit
-        line = trim(buf)
-        if (line(1:1) /= '#') then
-          read (line, *, iostat=ios) tt, ss
-          if (ios /= 0 .or. nint(ss) > last) exit
-          out%rows = out%rows + 1
-        end if
-        keep = [keep, buf]
-      end do
-      close (uu)
-      open (newunit=out%hist, file=out%dir//'/history.dat', status='replace')
-      out%hist_open = .true.
-      do i = 1, size(keep)
-        write (out%hist, '(a)') trim(keep(i))
-      end do
-    end subroutine keep_history
-
     !> the frames of the earlier run.pvd with time <= tmax
     subroutine keep_frames(tmax, e)
       real(dp), intent(in) :: tmax
@@ -158,6 +129,90 @@ contains
     end subroutine keep_frames
   end subroutine output_open
 
+  !> Restart: cut history.dat back to the rows of steps <= last (rows after the checkpoint, or
+  !> a line cut short by a crash, go), which must end at step last, and make history.h5 anew
+  !> from them: the .dat is flushed at every checkpoint, while an HDF5 file killed between two
+  !> flushes may be unreadable. Nothing is changed unless the history reaches step last.
+  subroutine keep_history(out, cols, last, err)
+    type(output_t), intent(inout) :: out
+    character(len=*), intent(in) :: cols(:)
+    integer, intent(in) :: last
+    type(error_t), allocatable, intent(out) :: err
+    character(len=:), allocatable :: path
+    character(len=max_line) :: buf
+    character(len=256) :: msg
+    real(dp) :: row(size(cols))
+    integer :: u, ios
+    path = out%dir//'/history.dat'
+    call cut_history(path, size(cols), last, err)
+    if (allocated(err)) return
+    call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
+    if (allocated(err)) return
+    open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+    do while (ios == 0 .and. .not. allocated(err))
+      read (u, '(a)', iostat=ios) buf
+      if (ios /= 0 .or. buf(1:1) == '#') cycle
+      read (buf, *, iostat=ios) row
+      out%rows = out%rows + 1
+      call h5_table_append(out%h5, row, err)
+    end do
+    close (u)
+    if (.not. allocated(err)) call h5_table_flush(out%h5, err)
+    if (allocated(err)) return
+    call cf_open(out%hist, path, 'a', err)
+    out%hist_open = .not. allocated(err)
+  end subroutine keep_history
+
+  !> Replace the history file path by its header and rows (of ncol numbers) up to step last,
+  !> written to path.part and renamed when complete; an error if the rows end before last.
+  subroutine cut_history(path, ncol, last, err)
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: ncol, last
+    type(error_t), allocatable, intent(out) :: err
+    type(checked_file_t) :: part
+    character(len=max_line) :: buf
+    character(len=256) :: msg
+    real(dp) :: row(ncol)
+    integer :: u, ios, step
+    open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call fatal_error(err, 'restart: '//path//': '//trim(msg)); return
+    end if
+    call cf_open(part, path//'.part', 'w', err)
+    step = -1
+    do while (.not. allocated(err))
+      read (u, '(a)', iostat=ios) buf
+      if (ios /= 0) exit
+      if (buf(1:1) /= '#') then
+        read (buf, *, iostat=ios) row
+        if (ios /= 0 .or. nint(row(2)) > last) exit
+        step = nint(row(2))
+      end if
+      call cf_write(part, trim(buf)//new_line('a'), err)
+    end do
+    close (u)
+    if (.not. allocated(err)) call cf_close(part, err)
+    if (.not. allocated(err) .and. step /= last) &
+      call fatal_error(err, 'restart: '//path//' ends at step '//itoa(step)// &
+                       ', before the checkpoint''s step '//itoa(last)//' (another run''s history?)')
+    if (allocated(err)) then
+      call cf_discard(part); return
+    end if
+    if (.not. rename_file(path//'.part', path)) &
+      call fatal_error(err, 'restart: cannot rename '//path//'.part to '//path)
+  end subroutine cut_history
+
+  !> The words, trimmed, each between before and after, as one text
+  pure function join(words, before, after) result(text)
+    character(len=*), intent(in) :: words(:), before, after
+    character(len=:), allocatable :: text
+    integer :: k
+    text = ''
+    do k = 1, size(words)
+      text = text//before//trim(words(k))//after
+    end do
+  end function join
+
   !> One row: time, energies, momenta, contacts, Newton iterations, deepest penetration of a
   !> node without constraint, negative pivots of the last factorisation (the inertia of the
   !> saddle-point matrix: one per active constraint), the most tensile multiplier and the
@@ -172,6 +227,7 @@ contains
     real(dp), intent(in) :: fcontact, penetration, lambda_max, gap_max
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: row(:)
+    character(len=max_line) :: line
     integer :: k, n
     if (.not. is_root()) return
     row = [st%t, real(st%step, dp), bal%kinetic, bal%strain, bal%work, bal%total, bal%p, bal%l, &
@@ -181,10 +237,22 @@ contains
       n = out%tracked(k)
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]
     end do
-    write (out%hist, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
+    write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
+    call cf_write(out%hist, trim(line)//new_line('a'), err)
+    if (allocated(err)) return
     out%rows = out%rows + 1
     call h5_table_append(out%h5, row, err)
   end subroutine output_history
+
+  !> Push the history rows written so far to both files (at a checkpoint: a restart from it
+  !> finds every row up to its step).
+  subroutine output_flush(out, err)
+    type(output_t), intent(inout) :: out
+    type(error_t), allocatable, intent(out) :: err
+    if (.not. is_root() .or. .not. out%hist_open) return
+    call cf_flush(out%hist, err)
+    if (.not. allocated(err)) call h5_table_flush(out%h5, err)
+  end subroutine output_flush
 
   !> A VTU frame of the state and its entry in run.pvd. extra: more point fields (contact).
   subroutine output_frame(out, model, st, extra, err)
@@ -197,6 +265,10 @@ contains
     character(len=32) :: name
     integer :: n, e, b
     if (.not. is_root()) return
+    if (.not. (all(ieee_is_finite(st%q)) .and. all(ieee_is_finite(st%qd)))) then
+      call fatal_error(err, 'the state at step '//itoa(st%step)//' is not finite; no frame written')
+      return
+    end if
     allocate (x(3, model%nnode), u(3, model%nnode), v(3, model%nnode), g(3, model%nnode), &
               a(1, model%nnode), body(1, model%nelem), vm(1, model%nelem))
     do n = 1, model%nnode
@@ -226,14 +298,32 @@ contains
     call write_pvd(out%dir//'/run.pvd', out%files, out%times, err)
   end subroutine output_frame
 
+  !> Close the files (every close checked: a full disk shows here last) and free the folder.
   subroutine output_close(out, err)
     type(output_t), intent(inout) :: out
     type(error_t), allocatable, intent(out) :: err
     if (.not. is_root()) return
-    if (out%hist_open) close (out%hist)
+    if (out%hist_open) call cf_close(out%hist, err)
+    if (allocated(err)) call cut_to_last_line(out%dir//'/history.dat')
     out%hist_open = .false.
-    call h5_table_flush(out%h5, err)
-    if (allocated(err)) return
-    call h5_table_close(out%h5, err)
+    if (.not. allocated(err)) call h5_table_flush(out%h5, err)
+    if (.not. allocated(err)) call h5_table_close(out%h5, err)
+    call output_release(out)
   end subroutine output_close
+
+  !> After an error: close what is open, quietly (the error is reported already), and free
+  !> the folder.
+  subroutine output_release(out)
+    type(output_t), intent(inout) :: out
+    type(error_t), allocatable :: e
+    if (.not. is_root()) return
+    if (out%hist_open) then
+      call cf_close(out%hist, e)
+      call cut_to_last_line(out%dir//'/history.dat')
+    end if
+    out%hist_open = .false.
+    call h5_table_close(out%h5, e)
+    if (out%locked) call unlock_folder(out%dir)
+    out%locked = .false.
+  end subroutine output_release
 end module casca_output

@@ -9,6 +9,7 @@
 !> Units are SI as the solver writes them (s, m, J, N); time is plotted in ms.
 module casca_plots
   use casca_error, only: error_t, fatal_error
+  use casca_strings, only: itoa
   implicit none
   private
   public :: make_plots
@@ -60,26 +61,18 @@ contains
     call write_text(d//'/plots.gp', script, err)
     if (allocated(err)) return
 
-    ! The shell's `command -v` is the portable way to ask whether a program is on PATH. dash
-    ! answers 127 for "not found", which gfortran reports as a cmdstat failure, hence || exit 1.
-    cmsg = ''
-    call execute_command_line('command -v gnuplot >/dev/null 2>&1 || exit 1', exitstat=stat, &
-                              cmdstat=cstat, cmdmsg=cmsg)
-    if (cstat /= 0) then
-      call fatal_error(err, 'make_plots: cannot run shell commands (needed for gnuplot): ' &
-                       //trim(cmsg))
-      return
-    end if
-    if (stat /= 0) then
-      if (present(gnuplot_missing)) gnuplot_missing = .true.
-      return
-    end if
-
-    cmd = 'cd '//shell_quote(d)//' && gnuplot plots.gp'
+    ! The one shell of casca: `command -v` is the portable way to ask whether gnuplot is on
+    ! PATH (dash answers 127 for "not found", which gfortran reports as a cmdstat failure,
+    ! hence exit 99); the folder is one quoted word.
+    if (d(1:1) /= '/') d = './'//d   ! a folder named -x is not an option of cd
+    cmd = 'cd '//shell_quote(d)//' && { command -v gnuplot >/dev/null 2>&1 || exit 99; } && ' &
+          //'gnuplot plots.gp'
     cmsg = ''
     call execute_command_line(cmd, exitstat=stat, cmdstat=cstat, cmdmsg=cmsg)
     if (cstat /= 0) then
       call fatal_error(err, 'make_plots: could not run `'//cmd//'`: '//trim(cmsg))
+    else if (stat == 99) then
+      if (present(gnuplot_missing)) gnuplot_missing = .true.
     else if (stat /= 0) then
       call fatal_error(err, 'make_plots: `'//cmd//'` failed with exit status '//itoa(stat))
     end if
@@ -484,7 +477,8 @@ contains
     q = q//"'"
   end function shell_quote
 
-  !> Body of a gnuplot single-quoted string: only ' is special there, written ''.
+  !> Body of a gnuplot single-quoted string. ' is written as the typographic apostrophe
+  !> U+2019: gnuplot's '' escape fails where two meet (a name with '' ended the string).
   pure function gp_quote(s) result(q)
     character(len=*), intent(in) :: s
     character(len=:), allocatable :: q
@@ -492,7 +486,7 @@ contains
     q = ''
     do i = 1, len(s)
       if (s(i:i) == "'") then
-        q = q//"''"
+        q = q//char(226)//char(128)//char(153)
       else if (iachar(s(i:i)) < 32) then
         q = q//' '            ! control characters would end or garble the command
       else
@@ -521,12 +515,4 @@ contains
       if (q(i:i) == achar(9) .or. q(i:i) == achar(13)) q(i:i) = ' '
     end do
   end function untab
-
-  pure function itoa(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=16) :: buf
-    write (buf, '(i0)') i
-    s = trim(buf)
-  end function itoa
 end module casca_plots

@@ -1,54 +1,86 @@
 !> Checks of a deck's values before any work (CaNS's sanity module): every problem is added
 !> to deck%problems with the deck's file name, the group's line and the field.
 module casca_sanity
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use casca_kinds, only: dp
   use casca_deck, only: deck_t, add_problem, unset, deck_file
+  use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
+  use casca_mesh_generators, only: generated_elements, max_generated_elements
+  use casca_strings, only: itoa
   implicit none
   private
   public :: check_deck, parse_fix
+
+  !> Largest size of a number in a deck: far beyond any scene or material, far below the
+  !> overflow of the products casca forms (a 1e308 passed every check and overflowed later)
+  real(dp), parameter :: max_real = 1e30_dp
+  !> Memory a model needs per element, measured with the factors of a sphere of 11,520
+  !> elements (36 kB; docs/performance.md has the run), with a margin
+  real(dp), parameter :: bytes_per_element = 40e3_dp
+  !> Most Newton iterations: newton.f90 keeps the history of at most 100 (its max_hist)
+  integer, parameter :: max_newton_iter = 100
+  !> Most step halvings: the driver divides dt by the 32-bit integer 2**level
+  integer, parameter :: max_cuts = 30
+  !> Most steps: the step counter has 32 bits
+  real(dp), parameter :: max_steps = 1e9_dp
+  !> Most frames: they are named frame_NNNNN.vtu
+  real(dp), parameter :: max_frames = 99999
 
 contains
 
   subroutine check_deck(deck)
     type(deck_t), intent(inout) :: deck
     integer :: i, j, n
-    logical :: exists
     character(len=16) :: ns
     logical :: comps(7), ok
 
-    associate (r => deck%run)
+    associate (r => deck%run, l => deck%run%line)
       select case (r%analysis)
       case ('dynamic')
-        call positive(0, '&run: dt', r%dt)
-        call positive(0, '&run: t_end', r%t_end)
-        if (r%dt /= unset .and. r%t_end /= unset .and. r%dt > 0) then
-          if (r%dt > r%t_end) call add_problem(deck, 0, '&run: dt is larger than t_end')
+        call positive(l, '&run: dt', r%dt)
+        call positive(l, '&run: t_end', r%t_end)
+        if (r%dt > 0 .and. r%t_end > 0 .and. r%t_end <= max_real) then
+          if (r%dt > r%t_end) call add_problem(deck, l, '&run: dt is larger than t_end')
+          if (r%t_end/r%dt > max_steps) call add_problem(deck, l, '&run: t_end/dt = '// &
+            num(r%t_end/r%dt)//' steps, more than the 1e9 a run can count')
         end if
-        call positive(0, '&run: beta', r%beta)
-        if (r%gamma < 0.5_dp) call add_problem(deck, 0, &
+        call positive(l, '&run: beta', r%beta)
+        call finite(l, '&run: gamma', [r%gamma])
+        if (r%gamma < 0.5_dp) call add_problem(deck, l, &
           '&run: gamma must be >= 0.5 (gamma < 1/2 makes Newmark unstable)')
       case ('static')
-        if (r%load_steps < 1) call add_problem(deck, 0, '&run: load_steps must be >= 1')
+        if (r%load_steps < 1) call add_problem(deck, l, '&run: load_steps must be >= 1')
       case default
-        call add_problem(deck, 0, '&run: analysis must be ''dynamic'' or ''static'' (got '''// &
+        call add_problem(deck, l, '&run: analysis must be ''dynamic'' or ''static'' (got '''// &
                          trim(r%analysis)//''')')
       end select
-      call positive(0, '&run: newton_tol', r%newton_tol)
-      if (r%newton_max_iter < 1) call add_problem(deck, 0, '&run: newton_max_iter must be >= 1')
-      if (r%max_step_cuts < 0) call add_problem(deck, 0, '&run: max_step_cuts must be >= 0')
+      call positive(l, '&run: newton_tol', r%newton_tol)
+      call finite(l, '&run: gravity', r%gravity)
+      if (r%newton_max_iter < 1 .or. r%newton_max_iter > max_newton_iter) call add_problem(deck, &
+        l, '&run: newton_max_iter must be in 1..'//itoa(max_newton_iter)//' (got '// &
+        itoa(r%newton_max_iter)//')')
+      if (r%max_step_cuts < 0 .or. r%max_step_cuts > max_cuts) call add_problem(deck, l, &
+        '&run: max_step_cuts must be in 0..'//itoa(max_cuts)//' (got '//itoa(r%max_step_cuts)//')')
       if (r%ordering /= 'auto' .and. r%ordering /= 'metis') &
-        call add_problem(deck, 0, '&run: ordering must be ''auto'' or ''metis''')
+        call add_problem(deck, l, '&run: ordering must be ''auto'' or ''metis''')
     end associate
 
-    associate (o => deck%output)
-      if (o%interval /= unset .and. .not. (o%interval > 0)) &
-        call add_problem(deck, 0, '&output: interval must be > 0')
+    associate (o => deck%output, l => deck%output%line)
+      if (o%interval /= unset) call positive(l, '&output: interval', o%interval)
+      call finite(l, '&output: checkpoint_interval', [o%checkpoint_interval])
       if (o%checkpoint_interval < 0) &
-        call add_problem(deck, 0, '&output: checkpoint_interval must be >= 0')
-      if (len_trim(o%dir) == 0) call add_problem(deck, 0, '&output: dir is empty')
+        call add_problem(deck, l, '&output: checkpoint_interval must be >= 0')
+      if (o%vtu .and. o%interval > 0 .and. deck%run%t_end > 0 .and. deck%run%dt > 0 .and. &
+          deck%run%t_end <= max_real) then
+        if (deck%run%t_end/max(o%interval, deck%run%dt) > max_frames) call add_problem(deck, l, &
+          '&output: interval gives '//num(deck%run%t_end/max(o%interval, deck%run%dt))// &
+          ' frames, more than the 99999 of frame_NNNNN.vtu')
+      end if
+      if (len_trim(o%dir) == 0) call add_problem(deck, l, '&output: dir is empty')
+      call finite(l, '&output: track', reshape(o%track(:, 1:o%ntrack), [3*o%ntrack]))
       do i = 1, o%ntrack
         if (o%track_body(i) /= '' .and. find_body(o%track_body(i)) == 0) &
-          call add_problem(deck, 0, '&output: track_body('//itoa(i)//') = '''// &
+          call add_problem(deck, l, '&output: track_body('//itoa(i)//') = '''// &
                            trim(o%track_body(i))//''' is not a body of the deck')
       end do
     end associate
@@ -62,6 +94,8 @@ contains
           if (find_body(b%name) /= i) &
             call add_problem(deck, n, '&body: name '''//trim(b%name)//''' used twice')
         end if
+        call finite(n, '&body '//trim(b%name)//': center, rotate_axis, rotate_angle, velocity '// &
+                    'or omega', [b%center, b%rotate_axis, b%rotate_angle, b%velocity, b%omega])
         call positive(n, '&body '//trim(b%name)//': young', b%young)
         call positive(n, '&body '//trim(b%name)//': density', b%density)
         call positive(n, '&body '//trim(b%name)//': thickness', b%thickness)
@@ -75,21 +109,27 @@ contains
           call positive(n, '&body '//trim(b%name)//': width', b%width)
           if (b%n_around < 3 .or. b%n_across < 1) call add_problem(deck, n, '&body '// &
             trim(b%name)//': ring needs n_around >= 3 and n_across >= 1')
+          call check_size(n, b%name, b%mesh, b%n_around, b%n_across)
         case ('sphere')
           call positive(n, '&body '//trim(b%name)//': radius', b%radius)
           if (b%n_div < 1) call add_problem(deck, n, '&body '//trim(b%name)//': n_div must be >= 1')
+          call check_size(n, b%name, b%mesh, b%n_div, 0)
         case ('plate', 'strip')
           call positive(n, '&body '//trim(b%name)//': lx', b%lx)
           call positive(n, '&body '//trim(b%name)//': ly', b%ly)
           if (b%nx < 1 .or. b%ny < 1) call add_problem(deck, n, '&body '//trim(b%name)// &
             ': nx and ny must be >= 1')
+          call check_size(n, b%name, b%mesh, b%nx, b%ny)
         case ('file')
-          inquire (file=deck_file(deck, b%file), exist=exists)
           if (b%file == '') then
             call add_problem(deck, n, '&body '//trim(b%name)//': mesh = ''file'' needs file = ...')
-          else if (.not. exists) then
+          else if (file_kind(deck_file(deck, b%file)) == kind_missing) then
             call add_problem(deck, n, '&body '//trim(b%name)//': mesh file '''// &
                              deck_file(deck, b%file)//''' does not exist')
+          else if (file_kind(deck_file(deck, b%file)) /= kind_regular) then
+            call add_problem(deck, n, '&body '//trim(b%name)//': mesh file '''// &
+                             deck_file(deck, b%file)//''' is not a regular file (a folder, '// &
+                             'FIFO or device)')
           end if
         case ('')
           call add_problem(deck, n, '&body '//trim(b%name)// &
@@ -112,6 +152,8 @@ contains
           ''' (use clamped, pinned, all, or components among x y z gx gy gz a)')
         if (any(r%box_min > r%box_max)) call add_problem(deck, r%line, &
           '&restraint: box_min must not exceed box_max')
+        if (any(ieee_is_nan([r%box_min, r%box_max]))) call add_problem(deck, r%line, &
+          '&restraint: box_min and box_max must be numbers (not NaN)')
       end associate
     end do
     do i = 1, size(deck%loads)
@@ -122,9 +164,16 @@ contains
           '&load: nodes needs body = ... (node numbers count within a body)')
         if (any(l%box_min > l%box_max)) call add_problem(deck, l%line, &
           '&load: box_min must not exceed box_max')
+        if (any(ieee_is_nan([l%box_min, l%box_max]))) call add_problem(deck, l%line, &
+          '&load: box_min and box_max must be numbers (not NaN)')
+        call finite(l%line, '&load: force', l%force)
       end associate
     end do
+    call check_memory()
     do j = 1, deck%contact%npairs
+      if (deck%contact%pairs(1, j) == deck%contact%pairs(2, j)) call add_problem(deck, &
+        deck%contact%line, '&contact: pairs(:, '//itoa(j)//') pairs '''// &
+        trim(deck%contact%pairs(1, j))//''' with itself; self-contact is not supported')
       do i = 1, 2
         if (find_body(deck%contact%pairs(i, j)) == 0) then
           write (ns, '(i0)') j
@@ -143,14 +192,65 @@ contains
       integer, intent(in) :: line
       character(len=*), intent(in) :: field
       real(dp), intent(in) :: v
-      character(len=32) :: s
       if (v == unset) then
         call add_problem(deck, line, field//' is missing')
       else if (.not. (v > 0)) then
-        write (s, '(es12.4)') v
-        call add_problem(deck, line, field//' must be > 0 (got '//trim(adjustl(s))//')')
+        call add_problem(deck, line, field//' must be > 0 (got '//num(v)//')')
+      else if (.not. (v <= max_real)) then
+        call add_problem(deck, line, field//' must be > 0 and below 1e30 (got '//num(v)//')')
       end if
     end subroutine positive
+
+    !> v must be finite numbers below max_real in size (NaN fails every comparison)
+    subroutine finite(line, field, v)
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: field
+      real(dp), intent(in) :: v(:)
+      if (.not. all(abs(v) <= max_real)) call add_problem(deck, line, field// &
+        ' must be finite numbers below 1e30 in size (got '//num(v(maxloc(merge(1, 0, &
+        .not. abs(v) <= max_real), dim=1)))//')')
+    end subroutine finite
+
+    !> a generator's sizes must give at most max_generated_elements
+    subroutine check_size(line, name, kind, n1, n2)
+      integer, intent(in) :: line, n1, n2
+      character(len=*), intent(in) :: name, kind
+      if (generated_elements(kind, n1, n2) > max_generated_elements) call add_problem(deck, &
+        line, '&body '//trim(name)//': the sizes give '//num(generated_elements(kind, n1, n2))// &
+        ' elements, more than the 1e7 a generator makes')
+    end subroutine check_size
+
+    !> the generated bodies must fit in the machine's memory (before anything is allocated)
+    subroutine check_memory()
+      real(dp) :: elems(size(deck%bodies))
+      integer :: k
+      elems = 0
+      do k = 1, size(deck%bodies)
+        associate (b => deck%bodies(k))
+          select case (b%mesh)
+          case ('ring')
+            elems(k) = generated_elements(b%mesh, b%n_around, b%n_across)
+          case ('sphere')
+            elems(k) = generated_elements(b%mesh, b%n_div, 0)
+          case ('plate', 'strip')
+            elems(k) = generated_elements(b%mesh, b%nx, b%ny)
+          end select
+        end associate
+      end do
+      if (size(elems) == 0 .or. physical_memory() <= 0) return
+      if (sum(elems)*bytes_per_element > real(physical_memory(), dp)) &   ! (at the largest body)
+        call add_problem(deck, deck%bodies(maxloc(elems, dim=1))%line, 'the generated meshes '// &
+          'have '//num(sum(elems))//' elements in all, needing about '//num(sum(elems)*bytes_per_element/1e9_dp)// &
+          ' GB of memory; this machine has '//num(real(physical_memory(), dp)/1e9_dp)//' GB')
+    end subroutine check_memory
+
+    function num(v) result(str)
+      real(dp), intent(in) :: v
+      character(len=:), allocatable :: str
+      character(len=32) :: b
+      write (b, '(es12.4e3)') v
+      str = trim(adjustl(b))
+    end function num
 
     integer function find_body(name)
       character(len=*), intent(in) :: name
@@ -162,14 +262,6 @@ contains
         end if
       end do
     end function find_body
-
-    function itoa(k) result(s)
-      integer, intent(in) :: k
-      character(len=:), allocatable :: s
-      character(len=16) :: b
-      write (b, '(i0)') k
-      s = trim(b)
-    end function itoa
   end subroutine check_deck
 
   !> Components fixed by a restraint: 'clamped' (position and fibre), 'pinned' (position),

@@ -15,7 +15,7 @@ module casca_vtu_writer
   use, intrinsic :: iso_fortran_env, only: int8, int32, int64
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_files, only: rename_file
+  use casca_files, only: rename_file, close_complete, delete_file
   implicit none
   private
   public :: field_t, field, write_vtu, write_pvd
@@ -204,7 +204,6 @@ contains
     integer, intent(in) :: u, ios_write
     character(len=*), intent(in) :: msg_write, tmp, path, who
     type(error_t), allocatable, intent(out) :: err
-    character(len=msg_len) :: msg
     integer :: ios, tmp_unit
 
     if (ios_write /= 0) then
@@ -212,9 +211,9 @@ contains
       call fatal_error(err, who//': error writing '//tmp//': '//trim(msg_write))
       return
     end if
-    close (u, status='keep', iostat=ios, iomsg=msg)
-    if (ios /= 0) then
-      call fatal_error(err, who//': error closing '//tmp//': '//trim(msg))
+    if (.not. close_complete(u, tmp)) then
+      call delete_file(tmp)
+      call fatal_error(err, who//': error writing '//tmp//' (is the disk full?)')
       return
     end if
     if (.not. rename_file(tmp, path)) then

@@ -56,8 +56,7 @@ contains
     allocate (eptr(ne + 1), eind(3*ne), epart(ne), npart(nnode))
     eptr = [(3*e, e=0, ne)]
     eind = reshape(conn(1:3, :) - 1, [3*ne])
-    status = metis_setdefaultoptions(options)
-    options(18) = 0   ! METIS_OPTION_NUMBERING: C style (0-based)
+    status = metis_setdefaultoptions(options)   ! numbering from 0 is METIS's default
     status = metis_partmeshdual(int(ne, c_int), int(nnode, c_int), eptr, eind, c_null_ptr, &
                                 c_null_ptr, 2_c_int, int(nparts, c_int), c_null_ptr, options, &
                                 objval, epart, npart)
@@ -92,8 +91,7 @@ contains
     fill = 0; mark = 0
     call walk(.true.)
     allocate (nperm(nnode), niperm(nnode))
-    status = metis_setdefaultoptions(options)
-    options(18) = 0
+    status = metis_setdefaultoptions(options)   ! numbering from 0 is METIS's default
     status = metis_nodend(int(nnode, c_int), xadj, adj, c_null_ptr, options, nperm, niperm)
     if (status /= metis_ok) then
       call fatal_error(err, 'METIS_NodeND failed')

@@ -165,7 +165,9 @@ contains
     self%analysed = .false.; self%factored = .false.
   end subroutine solver_new_pattern
 
-  subroutine solver_finish(self)
+  !> Free the instance (JOB = -2; collective over its ranks). Elemental, so that the driver
+  !> ends all its solvers with one call.
+  impure elemental subroutine solver_finish(self)
     class(sparse_solver_t), intent(inout) :: self
     if (.not. self%started) return
     if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)

@@ -1,0 +1,347 @@
+"""casca as a hostile or unlucky user meets it (issue 15): crashes and restarts, a full disk,
+two runs in one folder, foreign checkpoints, shell injection, non-finite numbers, an error on
+one of two MPI ranks. Each case asserts exit codes and file contents against an independent
+answer (an uninterrupted run, the file system, the deck's own numbers).
+
+usage: test_faults.py CASCA MESH_DIR WORK_DIR
+"""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+from casca_testlib import ENV, Checks, history, run
+
+casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+ck = Checks()
+ring = os.path.join(meshdir, "ring_20x1.msh")
+
+# two rings meeting at 10 m/s; 200 steps, a checkpoint every 10 steps
+deck_text = """&run
+  dt = 5.0e-5, t_end = T_END
+/
+&output
+  dir = 'DIR'
+  interval = 5.0e-4, checkpoint_interval = 5.0e-4
+  track = 1.0, 0.0, 0.0,   1.01, 0.0, 0.0
+  track_body = 'ring1', 'ring2'
+/
+&body
+  name = 'ring1', mesh = 'file', file = 'RING'
+  velocity = 10.0, 0.0, 0.0
+  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05
+/
+&body
+  name = 'ring2', mesh = 'file', file = 'RING', center = 2.01, 0.0, 0.0
+  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05
+/
+""".replace("RING", ring)
+
+
+def deck(name, t_end="1.0e-2", out="out", extra=""):
+    path = os.path.join(work, name + ".nml")
+    with open(path, "w") as f:
+        f.write(deck_text.replace("T_END", t_end).replace("DIR", out) + extra)
+    return path
+
+
+def clean(p):
+    """exit with a code of casca's (never a signal, a backtrace or a runtime error)"""
+    return (p.returncode in (0, 2, 3) and "Backtrace" not in p.stderr
+            and "Fortran runtime error" not in p.stderr and "Error termination" not in p.stderr)
+
+
+def first_line(p):
+    lines = [l for l in p.stderr.splitlines() if l.startswith("error")]
+    return "exit %d: %s" % (p.returncode, lines[0] if lines else p.stderr.strip()[-200:])
+
+
+def ckpt_step(path):
+    try:
+        with h5py.File(path, "r") as f:
+            return int(f["step"][()])
+    except (OSError, KeyError):
+        return -1
+
+
+def table(folder):
+    with h5py.File(os.path.join(folder, "history.h5"), "r") as f:
+        return f["history"][()]
+
+
+# --- kill and restart: a run killed at several moments (kill -9 right after a checkpoint,
+# between two, during contact, SIGTERM) and restarted each time from its own checkpoint in the
+# same folder ends with the history of the uninterrupted run, in both files, to 1e-12
+ref_out = os.path.join(work, "uninterrupted")
+p = run([casca, "run", deck("ref", out=ref_out), "-q"])
+ck.record("uninterrupted run (exit 0)", p.returncode == 0, first_line(p))
+ref = np.loadtxt(os.path.join(ref_out, "history.dat"))
+kill_out = os.path.join(work, "killed")
+kdeck = deck("killed", out=kill_out)
+ckpt = os.path.join(kill_out, "checkpoint.h5")
+moments = [(10, 0.0, signal.SIGKILL), (40, 0.03, signal.SIGKILL), (70, 0.11, signal.SIGTERM),
+           (110, 0.07, signal.SIGKILL), (150, 0.0, signal.SIGKILL)]
+killed_at, restarts_ok = [], True
+for i, (after, wait, sig) in enumerate(moments):
+    args = [casca, "run", kdeck, "-q"] + (["--restart", ckpt] if i > 0 else [])
+    proc = subprocess.Popen(args, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    while proc.poll() is None and ckpt_step(ckpt) < after:
+        time.sleep(0.01)
+    time.sleep(wait)
+    if proc.poll() is None:
+        proc.send_signal(sig)
+    out_, err_ = proc.communicate()
+    killed_at.append((ckpt_step(ckpt), proc.returncode))
+    if i > 0 and not (proc.returncode < 0 or proc.returncode == 0):
+        restarts_ok = False
+        print("restart %d: exit %d: %s" % (i, proc.returncode, err_[-300:]))
+p = run([casca, "run", kdeck, "-q", "--restart", ckpt])
+ck.record("restarts after kill -9 / SIGTERM at %d moments accepted, the last ends with exit 0"
+          % len(moments), restarts_ok and p.returncode == 0,
+          "checkpoint step and exit per kill %s; %s" % (killed_at, first_line(p)))
+ck.record("the runs were killed at different checkpoints (really interrupted)",
+          len(set(s for s, c in killed_at if c < 0)) >= 3, str(killed_at))
+h = np.loadtxt(os.path.join(kill_out, "history.dat"))
+ck.record("history.dat after the restarts has the uninterrupted run's steps",
+          h.shape == ref.shape and np.array_equal(h[:, 1], ref[:, 1]), "%s vs %s" % (h.shape, ref.shape))
+if h.shape == ref.shape:
+    scale = np.maximum(np.max(np.abs(ref), axis=0), 1e-300)
+    ck.le("history.dat equals the uninterrupted run's (max relative to each column's size)",
+          np.max(np.abs(h - ref) / scale), 1e-12)
+    t5 = table(kill_out)
+    ck.le("history.h5 after the restarts equals the uninterrupted run's history.dat",
+          np.max(np.abs(t5 - ref) / scale) if t5.shape == ref.shape else np.inf, 1e-12)
+ck.record("the folder's lock is gone after the last run", not os.path.exists(os.path.join(kill_out, "casca.lock")))
+
+# --- two runs into one folder: the second is refused (exit 2) while the first runs, and the
+# first ends as if alone (its history equals the uninterrupted run's, no NUL byte)
+lock_out = os.path.join(work, "locked")
+ldeck = deck("locked", out=lock_out)
+first = subprocess.Popen([casca, "run", ldeck, "-q"], env=ENV, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+while first.poll() is None and ckpt_step(os.path.join(lock_out, "checkpoint.h5")) < 10:
+    time.sleep(0.01)
+second = run([casca, "run", ldeck, "-q"])
+first.communicate()
+ck.record("a second run into a folder in use: exit 2, the lock named",
+          second.returncode == 2 and "in use by another casca run" in second.stderr and clean(second),
+          first_line(second))
+ck.record("the first run still ends with exit 0", first.returncode == 0, "exit %d" % first.returncode)
+raw = open(os.path.join(lock_out, "history.dat"), "rb").read()
+hl = np.loadtxt(os.path.join(lock_out, "history.dat"))
+ck.record("the first run's history.dat has no NUL byte and all %d rows" % len(ref),
+          b"\0" not in raw and hl.shape == ref.shape, str(hl.shape))
+if hl.shape == ref.shape:
+    ck.le("the first run's history equals the uninterrupted run's (relative)",
+          np.max(np.abs(hl - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300)), 1e-12)
+dead = subprocess.Popen(["true"])
+dead.wait()
+with open(os.path.join(lock_out, "casca.lock"), "w") as f:
+    f.write("%d\n" % dead.pid)
+p = run([casca, "run", deck("stale", t_end="5.0e-4", out=lock_out), "-q"])
+ck.record("a lock left by a dead process is taken over, with a warning (exit 0)",
+          p.returncode == 0 and "took over" in p.stderr and str(dead.pid) in p.stderr
+          and not os.path.exists(os.path.join(lock_out, "casca.lock")), first_line(p))
+
+# --- shell injection: folder names from the deck and from --out and body names are only
+# names: no command runs, the folder is made with the literal name, the plots are drawn
+inj = os.path.join(work, "inj")
+os.makedirs(inj)
+for i, name in enumerate(["d_$(touch M1)", 'd";touch M2;"', "--help", "d`touch M3`"]):
+    p = run([casca, "run", deck("inj%d" % i, t_end="5.0e-4", out=name), "-q"], cwd=inj)
+    ck.record("dir = %r: exit 0 and the output in a folder of that name" % name,
+              p.returncode == 0 and os.path.isfile(os.path.join(inj, name, "history.dat")), first_line(p))
+p = run([casca, "run", deck("inj_out", t_end="5.0e-4"), "-q", "--out", "o$(touch M4)"], cwd=inj)
+ck.record("--out 'o$(touch M4)': exit 0, folder of that name",
+          p.returncode == 0 and os.path.isfile(os.path.join(inj, "o$(touch M4)", "history.dat")), first_line(p))
+body = "it''s `touch M5` $(touch M6) a''''b"   # in the deck's quotes: it's ... a''b
+named = deck("inj_name", t_end="5.0e-4")
+text = open(named).read().replace("'ring1'", "'%s'" % body)
+with open(named, "w") as f:
+    f.write(text)
+p = run([casca, "run", named, "-q", "--out", "named"], cwd=inj)
+folder = os.path.join(inj, "named")
+pngs = [f for f in os.listdir(folder) if f.endswith(".png")] if os.path.isdir(folder) else []
+ck.record("a body name with quotes, backquotes and $(...): exit 0 and all 8 plots",
+          p.returncode == 0 and len(pngs) == 8 and "warning" not in p.stderr,
+          "%s, %d plots" % (first_line(p), len(pngs)))
+marks = [m for m in ("M1", "M2", "M3", "M4", "M5", "M6") if os.path.exists(os.path.join(inj, m))]
+ck.record("no injected command ran (no marker file)", not marks, "markers: %s" % marks)
+
+# --- foreign and damaged checkpoints are refused (exit 2) before anything is written
+good_ckpt = os.path.join(ref_out, "checkpoint.h5")
+
+
+def refused(name, deck_path, ckpt_path, needle):
+    out = os.path.join(work, "foreign_" + name.split()[0])
+    p = run([casca, "run", deck_path, "-q", "--out", out, "--restart", ckpt_path])
+    ck.record("checkpoint %s: refused (exit 2, '%s')" % (name, needle),
+              p.returncode == 2 and needle in p.stderr and clean(p)
+              and not os.path.exists(os.path.join(out, "history.dat")), first_line(p))
+
+
+def variant(name, old, new):
+    path = deck(name)
+    text = open(path).read().replace(old, new, 1)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+refused("of another mesh with the same count", variant("moved", "center = 2.01", "center = 2.02"),
+        good_ckpt, "another model")
+refused("of another material", variant("soft", "young = 210e9", "young = 70e9"), good_ckpt,
+        "another model")
+
+
+def tampered(name, change, needle):
+    path = os.path.join(work, "tampered_%s.h5" % name.split()[0])
+    shutil.copy(good_ckpt, path)
+    with h5py.File(path, "r+") as f:
+        change(f)
+    refused(name, deck("plain"), path, needle)
+
+
+def set_ds(f, name, value):
+    del f[name]
+    f[name] = value
+
+
+tampered("step-cut level 60", lambda f: set_ds(f, "ints", np.array([60, 0], dtype=np.int32)), "step-cut level")
+tampered("contact count 1e8", lambda f: set_ds(f, "ints", np.array([0, 100000000], dtype=np.int32)),
+         "contact count")
+tampered("time past t_end", lambda f: set_ds(f, "t", np.float64(1.0)), "outside [0, t_end]")
+tampered("NaN state", lambda f: f["qd"].__setitem__(5, np.nan), "not finite")
+tampered("without fingerprint", lambda f: f.__delitem__("fingerprint"), "no model fingerprint")
+
+# --- an error on rank 0 only (the output folder cannot be made) ends both ranks, exit 2
+blocker = os.path.join(work, "a_file")
+open(blocker, "w").close()
+t0 = time.time()
+try:
+    p = run([casca, "run", deck("np2", t_end="5.0e-4"), "-q", "--out", os.path.join(blocker, "sub")],
+            np_ranks=2, timeout=60)
+    ck.record("2 ranks, output folder cannot be made: exit 2, the message once",
+              p.returncode == 2 and p.stderr.count("cannot create the output folder") == 1,
+              "%s in %.1f s" % (first_line(p), time.time() - t0))
+except subprocess.TimeoutExpired:
+    ck.record("2 ranks, output folder cannot be made: exit 2", False, "hung for 60 s")
+
+# --- a full disk (small tmpfs, filled at different moments by its size): a message and a
+# non-zero exit, never a signal; no file under its final name is cut short, no .part is left
+import xml.etree.ElementTree as ET
+import meshio
+
+
+def complete_outputs(folder):
+    """names of the files in folder that are not complete and readable ([] if all are)"""
+    bad = [f for f in os.listdir(folder) if f.endswith(".part")]
+    for f in os.listdir(folder):
+        path = os.path.join(folder, f)
+        try:
+            if f.endswith(".vtu"):
+                meshio.read(path)
+            elif f.endswith(".h5"):
+                with h5py.File(path, "r") as g:
+                    list(g)
+            elif f == "run.pvd":
+                for d in ET.parse(path).getroot().iter("DataSet"):
+                    if not os.path.exists(os.path.join(folder, d.get("file"))):
+                        bad.append(d.get("file"))
+            elif f == "history.dat":
+                text = open(path).read()
+                ncol = len(text.splitlines()[0].split()) - 1
+                if not text.endswith("\n") or any(len(l.split()) != ncol for l in text.splitlines()[1:]):
+                    bad.append(f)
+        except Exception as e:
+            bad.append("%s (%s)" % (f, str(e)[:60]))
+    return bad
+
+
+disk = os.path.join(work, "disk")
+os.makedirs(disk)
+mounted = False
+if os.geteuid() != 0:
+    print("SKIP full disk: not root, cannot mount a small tmpfs")
+else:
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=600k", "tmpfs", disk], capture_output=True, text=True)
+    mounted = m.returncode == 0
+    if not mounted:
+        print("SKIP full disk: mount -t tmpfs failed: " + m.stderr.strip())
+try:
+    for size in (["100k", "200k", "300k", "600k"] if mounted else []):
+        out = os.path.join(disk, "o")
+        shutil.rmtree(out, ignore_errors=True)
+        subprocess.run(["mount", "-o", "remount,size=" + size, disk], check=True)
+        p = run([casca, "run", deck("disk", t_end="3.0e-3", out=out), "-q"])
+        ok = p.returncode in (2, 3) and clean(p) and "disk full" in p.stderr
+        bad = complete_outputs(out) if os.path.isdir(out) else []
+        ck.record("disk of %s filled by the run: non-zero exit (no signal), a message" % size, ok, first_line(p))
+        ck.record("disk of %s: every file under its final name complete, no .part left" % size, not bad,
+                  "incomplete: %s" % bad)
+    if mounted:   # casca mesh writes its file the same way
+        shutil.rmtree(os.path.join(disk, "o"), ignore_errors=True)   # (a tmpfs shrinks only when empty)
+        subprocess.run(["mount", "-o", "remount,size=100k", disk], check=True)
+        msh = os.path.join(disk, "s.msh")
+        p = run([casca, "mesh", "sphere", "--n-div", "12", "-o", msh])
+        ck.record("casca mesh onto a full disk: exit 2, a message, no file left",
+                  p.returncode == 2 and clean(p) and "disk full" in p.stderr
+                  and not os.path.exists(msh) and not os.path.exists(msh + ".part"), first_line(p))
+finally:
+    if mounted:
+        subprocess.run(["umount", disk])
+
+# --- bad numbers and names: refused with exit 2 before anything is allocated, the file and
+# line named (lines counted in the deck text above: &run on line 1, ring1's &body on line 10)
+lines = open(ring).read().split("\n")
+first_xyz = lines.index("$Nodes") + 3 + 240   # MSH 4.1: summary, block header, 240 tags
+bad_meshes = {}
+for name, value in (("nan", "nan 0 0"), ("inf", "1.0 inf 0"), ("huge", "1e308 0 0")):
+    path = os.path.join(work, "coord_%s.msh" % name)
+    with open(path, "w") as f:
+        f.write("\n".join(lines[:first_xyz] + [value] + lines[first_xyz + 1:]))
+    bad_meshes[name] = path
+fifo = os.path.join(work, "mesh.fifo")
+os.mkfifo(fifo)
+one_ring = "'ring1', mesh = 'file', file = '%s'" % ring
+cases = [  # (name, old, new, substrings of the message)
+    ("t_end = Infinity", "t_end = 1.0e-2", "t_end = Infinity", [":1:", "t_end", "below 1e30"]),
+    ("dt = NaN", "dt = 5.0e-5", "dt = NaN", [":1:", "dt", "> 0"]),
+    ("young = 1e308", "young = 210e9", "young = 1e308", [":10:", "young", "below 1e30"]),
+    ("velocity NaN", "velocity = 10.0", "velocity = NaN", [":10:", "velocity", "finite"]),
+    ("n_around = 1e9", one_ring, "'ring1', mesh = 'ring', n_around = 1000000000", [":10:", "elements"]),
+    ("n_div = 1e5", one_ring, "'ring1', mesh = 'sphere', n_div = 100000", [":10:", "elements"]),
+    ("newton_max_iter = 200", "dt = 5.0e-5", "dt = 5.0e-5, newton_max_iter = 200", [":1:", "newton_max_iter", "1..100"]),
+    ("max_step_cuts = 60", "dt = 5.0e-5", "dt = 5.0e-5, max_step_cuts = 60", [":1:", "max_step_cuts", "0..30"]),
+    ("checkpoint_interval = -Infinity", "checkpoint_interval = 5.0e-4", "checkpoint_interval = -Infinity",
+     [":4:", "checkpoint_interval"]),
+    ("302-character dir", "dir = 'x'", "dir = '%s'" % ("d" * 302), [":4:", "dir", "longer than 256"]),
+    ("200-character body name", "'ring1', mesh", "'%s', mesh" % ("r" * 200), [":10:", "name", "longer than 64"]),
+    ("5000-character line", "/\n&body", "/\n!%s\n&body" % ("c" * 5000), [":10:", "line longer than 4096"]),
+    ("self-contact", "young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n/\n&body",
+     "young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n/\n&contact\n pairs = 'ring1', 'ring1'\n/\n&body",
+     ["&contact", "itself"]),
+    ("FIFO as mesh", one_ring, "'ring1', mesh = 'file', file = '%s'" % fifo, [":10:", "mesh.fifo", "not a regular file"]),
+] + [("%s coordinate in the mesh" % n, one_ring, "'ring1', mesh = 'file', file = '%s'" % p,
+      ["coord_%s.msh:%d:" % (n, first_xyz + 1), "finite"]) for n, p in bad_meshes.items()]
+for name, old, new, needles in cases:
+    path = deck("badnum", out="x")
+    text = open(path).read()
+    assert old in text, old
+    with open(path, "w") as f:
+        f.write(text.replace(old, new, 1))
+    try:
+        p = run([casca, "check", path], timeout=30)
+        ok = p.returncode == 2 and clean(p) and all(n in p.stderr for n in needles)
+        ck.record("%s: exit 2, message with %s" % (name, needles), ok, first_line(p)[:200])
+    except subprocess.TimeoutExpired:
+        ck.record("%s: exit 2" % name, False, "hung for 30 s")
+
+ck.finish()
