@@ -23,6 +23,10 @@ module casca_contact_correction
   private
   public :: contact_correction
 
+  type :: columns_t
+    real(dp), allocatable :: x(:, :)
+  end type columns_t
+
 contains
 
   !> Project v and a (full-length, every rank alike) onto the active constraints' persistent
@@ -33,24 +37,48 @@ contains
     type(model_t), intent(in) :: model
     real(dp), intent(inout) :: v(:), a(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), allocatable :: s(:, :), nu(:, :)
-    integer :: nc, k, info
+    real(dp), allocatable :: s(:, :), nu(:, :), b(:, :), x(:, :)
+    type(columns_t) :: held(3)   ! M^-1 C^T by component
+    integer :: nc, k, info, sv, comp, ncomp, j
+    integer, allocatable :: comps(:)
     nc = c%nact
     if (nc == 0) return
     allocate (s(nc, nc), nu(nc, 2))
-    call schur(err)   ! S = sum over components of B^T M^-1 B, B = C^T of the component
-    if (allocated(err)) return
     nu(:, 1) = -[(row_dot(k, v), k=1, nc)]
     nu(:, 2) = -[(row_dot(k, a), k=1, nc)]
+    ! S = sum over components of B^T M^-1 B (B: the component's part of C^T, as columns);
+    ! X = M^-1 B is kept: the corrections are X nu. One MUMPS call per distinct matrix.
+    s = 0
+    do sv = 1, 3
+      comps = pack([1, 2, 3], ms%solver_of == sv .and. ms%neq > 0)
+      ncomp = size(comps)
+      if (ncomp == 0) cycle
+      allocate (b(ms%neq(sv), ncomp*nc), x(ms%neq(sv), ncomp*nc))
+      do j = 1, ncomp
+        call columns(comps(j), b(:, (j - 1)*nc + 1:j*nc))
+      end do
+      call ms%solve(sv, b, x, err)
+      if (allocated(err)) return
+      do j = 1, ncomp
+        s = s + matmul(transpose(b(:, (j - 1)*nc + 1:j*nc)), x(:, (j - 1)*nc + 1:j*nc))
+        held(comps(j))%x = x(:, (j - 1)*nc + 1:j*nc)
+      end do
+      deallocate (b, x)
+    end do
+    s = 0.5_dp*(s + transpose(s))
     call dpotrf('L', nc, s, nc, info)
     if (info /= 0) then
       call fatal_error(err, 'contact correction: dependent constraints (C M^-1 C^T is singular)')
       return
     end if
     call dpotrs('L', nc, 2, s, nc, nu, nc, info)
-    call apply(nu(:, 1), v, err)
-    if (allocated(err)) return
-    call apply(nu(:, 2), a, err)
+    do comp = 1, 3   ! v += M^-1 C^T nu_v, a += M^-1 C^T nu_a
+      if (ms%neq(comp) == 0) cycle
+      associate (xc => held(comp)%x, d => ms%dofs(1:ms%neq(comp), comp))
+        v(d) = v(d) + matmul(xc, nu(:, 1))
+        a(d) = a(d) + matmul(xc, nu(:, 2))
+      end associate
+    end do
   contains
     !> B (equations of component comp, nc): the rows of C on that component, as columns
     subroutine columns(comp, b)
@@ -69,50 +97,6 @@ contains
         end do
       end do
     end subroutine columns
-
-    subroutine schur(e)
-      type(error_t), allocatable, intent(out) :: e
-      real(dp), allocatable :: b(:, :), x(:, :)
-      integer :: comp
-      s = 0
-      do comp = 1, 3
-        if (ms%neq(comp) == 0) cycle
-        allocate (b(ms%neq(comp), nc), x(ms%neq(comp), nc))
-        call columns(comp, b)
-        call ms%solve(comp, b, x, e)
-        if (allocated(e)) return
-        s = s + matmul(transpose(b), x)
-        deallocate (b, x)
-      end do
-      s = 0.5_dp*(s + transpose(s))
-    end subroutine schur
-
-    !> y = y + M^-1 C^T x, the impulse x along the constraints
-    subroutine apply(x, y, e)
-      real(dp), intent(in) :: x(:)
-      real(dp), intent(inout) :: y(:)
-      type(error_t), allocatable, intent(out) :: e
-      real(dp), allocatable :: b(:, :), z(:, :)
-      integer :: comp, i
-      do comp = 1, 3
-        if (ms%neq(comp) == 0) cycle
-        allocate (b(ms%neq(comp), nc), z(ms%neq(comp), 1))
-        call columns(comp, b)
-        call ms%solve(comp, matmul(b, reshape(x, [nc, 1])), z, e)
-        if (allocated(e)) return
-        do i = 1, model%ndof
-          if (ms%eq(i) > 0 .and. is_comp(i, comp)) y(i) = y(i) + z(ms%eq(i), 1)
-        end do
-        deallocate (b, z)
-      end do
-    end subroutine apply
-
-    pure logical function is_comp(i, comp)
-      integer, intent(in) :: i, comp
-      integer :: r
-      r = mod(i - 1, 7) + 1
-      is_comp = r == comp .or. r == comp + 3
-    end function is_comp
 
     !> row k of C times y: the normal relative rate of constraint k
     real(dp) function row_dot(k, y)

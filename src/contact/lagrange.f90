@@ -154,10 +154,11 @@ contains
         if (is_active(n, ip)) cycle
         call project(n, ip, cn, sd, found)
         if (.not. found) cycle
-        ! the sub-triangles are chords of the cubic surface, up to depth away from it: they
-        ! find the candidates, the constraint's own gap decides (else a node released with
-        ! zero gap would be taken again at once where the chord lies outside the surface)
-        if (sd >= c%depth(c%pair(2, ip)) .or. .not. has_free_position(n, cn%elem)) cycle
+        ! the sub-triangles are chords of the cubic surface: they find the candidates, the
+        ! constraint's own gap decides (else a node released with zero gap would be taken
+        ! again at once where the chord lies outside the surface). A cubic arc bulges from
+        ! its chord e by kappa e^2 / 8, below a quarter of depth = e / 2 while kappa e < 1
+        if (sd >= 0.25_dp*c%depth(c%pair(2, ip)) .or. .not. has_free_position(n, cn%elem)) cycle
         call finish(cn)
         if (cn%gap < -c%tol) then
           call push(cn)

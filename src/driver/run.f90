@@ -12,7 +12,7 @@ module casca_run
   use casca_mass_solver, only: mass_setup
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
-  use casca_accounting, only: balance_t, account, gravity_load
+  use casca_accounting, only: balance_t, account, gravity_load, balance_summary
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
                           output_flush, output_release
   use casca_vtu_writer, only: field_t, field
@@ -85,12 +85,12 @@ contains
     type(deck_t) :: deck
     type(model_t) :: model
     type(assembly_t) :: asm
-    type(linear_system_t) :: ls
+    type(linear_system_t), allocatable :: ls   ! (large: MUMPS structures)
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
     type(newmark_t) :: nm
-    type(balance_t) :: bal
+    type(balance_t) :: bal, bal0   !< now, and at the start of the run
     type(output_t) :: out
     type(contact_t) :: contact
     type(error_t), allocatable :: err
@@ -107,6 +107,7 @@ contains
     code = exit_ok
     call load_scene(path, deck, model, code)
     if (code /= exit_ok) return
+    allocate (ls)
     dir = trim(deck%output%dir)
     if (out_dir /= '') dir = trim(out_dir)
 
@@ -164,6 +165,7 @@ contains
       next_ckpt = (floor(st%t/deck%output%checkpoint_interval + 1e-9_dp) + 1)*deck%output%checkpoint_interval
     if (restart_step < 0) then
       call account(model, asm, st, fext, q0, bal)
+      bal0 = bal
       call history_row(0)
       if (failed('history')) return
       call frame()
@@ -387,6 +389,8 @@ contains
         print '(a,i0,a,a,a,a)', 'done: ', st%step, ' steps in ', seconds(wall_time() - t0), &
           ' s; results in ', dir
         print '(a)', timer_report(wall_time() - t0)
+        if (deck%run%analysis /= 'static' .and. restart_step < 0) &
+          print '(a)', balance_summary(bal0, bal, model%length)
       end if
     end subroutine finish
 

@@ -9,7 +9,7 @@ module casca_accounting
   use casca_vectors, only: cross
   implicit none
   private
-  public :: balance_t, account, gravity_load
+  public :: balance_t, account, gravity_load, balance_summary
 
   type :: balance_t
     real(dp) :: kinetic = 0, strain = 0, work = 0, total = 0
@@ -77,4 +77,22 @@ contains
     end do
   end subroutine gravity_load
 
+  !> What the run kept, from the state first accounted (b0) to b: the drift of the linear
+  !> momentum (of |p0|), of the angular momentum (of |L0|, or of |p0| times the scene size
+  !> when L0 is smaller) and the change of the total energy (of E0). Contact forces keep both
+  !> momenta; the Newmark step itself keeps the linear one only: its angular momentum
+  !> drifts with dt (docs/method.md), which is why the figure is printed.
+  function balance_summary(b0, b, length) result(line)
+    type(balance_t), intent(in) :: b0, b
+    real(dp), intent(in) :: length
+    character(len=:), allocatable :: line
+    character(len=200) :: buf
+    real(dp) :: pref, lref
+    pref = max(norm2(b0%p), tiny(1._dp))
+    lref = max(norm2(b0%l), pref*length)
+    write (buf, '(a,es8.1,a,es8.1,a,f8.5)') 'kept: linear momentum to ', norm2(b%p - b0%p)/pref, &
+      ', angular momentum to ', norm2(b%l - b0%l)/lref, '; energy E/E0 = ', &
+      b%total/max(abs(b0%total), tiny(1._dp))
+    line = trim(buf)
+  end function balance_summary
 end module casca_accounting

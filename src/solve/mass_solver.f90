@@ -2,6 +2,8 @@
 !> component x, y, z is a sparse symmetric positive definite system of its own (restrained
 !> parameters left out; A carries no mass), factorised once per run by MUMPS on each rank
 !> alone, for the contact correction, which is replicated like the contact itself.
+!> Components with the same restraints (the usual case) share one factorisation, so that
+!> the right-hand sides of all three go to MUMPS in one call.
 module casca_mass_solver
   use casca_kinds, only: dp
   use casca_error, only: error_t
@@ -14,8 +16,9 @@ module casca_mass_solver
 
   type :: mass_solver_t
     type(sparse_solver_t) :: m(3)        !< the scalar mass of component c's free parameters
-    integer, allocatable :: eq(:)        !< (ndof) equation of each Y, G parameter in its
+    integer, allocatable :: eq(:)        !< (ndof) equation of each free Y, G parameter in its
                                          !< component's system; 0 restrained, or A
+    integer, allocatable :: dofs(:, :)   !< (neq, c) the dof of each equation of component c
     integer :: neq(3) = 0
     integer :: solver_of(3) = [1, 2, 3]  !< components with the same restraints share one
   contains
@@ -25,31 +28,30 @@ module casca_mass_solver
 
 contains
 
-  !> Number, assemble and factorise the three component systems.
+  !> Number, assemble and factorise the component systems.
   subroutine mass_setup(model, ms, err)
     type(model_t), intent(in) :: model
     type(mass_solver_t), intent(inout) :: ms
     type(error_t), allocatable, intent(out) :: err
-    integer, allocatable :: irn(:), jcn(:), noperm(:)
+    integer, allocatable :: irn(:), jcn(:), noperm(:), comp_dofs(:)
     real(dp), allocatable :: a(:)
     integer :: c, c2, n, e, p, qq, k, ip, iq
-    allocate (ms%eq(model%ndof), noperm(0))
-    ms%eq = 0
+    allocate (ms%eq(model%ndof), ms%dofs(2*model%nnode, 3), noperm(0))
+    ms%eq = 0; ms%dofs = 0
     do c = 1, 3
       k = 0
       do n = 1, model%nnode
         do p = 0, 1   ! Y, then G
           if (model%fixed(dof(n, c + 3*p))) cycle
-          k = k + 1; ms%eq(dof(n, c + 3*p)) = k
+          k = k + 1; ms%eq(dof(n, c + 3*p)) = k; ms%dofs(k, c) = dof(n, c + 3*p)
         end do
       end do
       ms%neq(c) = k
     end do
     do c = 2, 3   ! same restraints as an earlier component: same matrix
       do c2 = 1, c - 1
-        if (all(model%fixed(dof([(n, n=1, model%nnode)], c)) .eqv. model%fixed(dof([(n, n=1, model%nnode)], c2))) .and. &
-            all(model%fixed(dof([(n, n=1, model%nnode)], c + 3)) .eqv. &
-                model%fixed(dof([(n, n=1, model%nnode)], c2 + 3)))) then
+        comp_dofs = [(dof(n, c), dof(n, c + 3), n=1, model%nnode)]
+        if (all(model%fixed(comp_dofs) .eqv. model%fixed(comp_dofs - c + c2))) then
           ms%solver_of(c) = ms%solver_of(c2); exit
         end if
       end do
@@ -83,14 +85,14 @@ contains
     end function param_dof
   end subroutine mass_setup
 
-  !> x = m^-1 b for component comp (b, x: (neq(comp), nrhs))
-  subroutine mass_solve(self, comp, b, x, err)
+  !> x = m^-1 b for the system of solver s (b, x: (its neq, nrhs))
+  subroutine mass_solve(self, s, b, x, err)
     class(mass_solver_t), intent(inout) :: self
-    integer, intent(in) :: comp
+    integer, intent(in) :: s
     real(dp), intent(in) :: b(:, :)
     real(dp), intent(out) :: x(:, :)
     type(error_t), allocatable, intent(out) :: err
-    call self%m(self%solver_of(comp))%solve(b, x, err)
+    call self%m(s)%solve(b, x, err)
   end subroutine mass_solve
 
   subroutine mass_finish(self)
