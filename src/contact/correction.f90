@@ -30,13 +30,14 @@ module casca_contact_correction
 contains
 
   !> Project v and a (full-length, every rank alike) onto the active constraints' persistent
-  !> contact: C v+ = 0, C a+ = 0.
-  subroutine contact_correction(ms, c, model, v, a, err)
+  !> contact: C v+ = 0, C a+ = 0. impulse: the velocity's nu (M (v+ - v) = C^T nu).
+  subroutine contact_correction(ms, c, model, v, a, err, impulse)
     type(mass_solver_t), intent(inout) :: ms
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(inout) :: v(:), a(:)
     type(error_t), allocatable, intent(out) :: err
+    real(dp), intent(out), optional :: impulse(:)
     real(dp), allocatable :: s(:, :), nu(:, :), b(:, :), x(:, :)
     type(columns_t) :: held(3)   ! M^-1 C^T by component
     integer :: nc, k, info, sv, comp, ncomp, j
@@ -72,6 +73,7 @@ contains
       return
     end if
     call dpotrs('L', nc, 2, s, nc, nu, nc, info)
+    if (present(impulse)) impulse = nu(:, 1)
     do comp = 1, 3   ! v += M^-1 C^T nu_v, a += M^-1 C^T nu_a
       if (ms%neq(comp) == 0) cycle
       associate (xc => held(comp)%x, d => ms%dofs(1:ms%neq(comp), comp))
