@@ -16,12 +16,12 @@ module casca_contact_correction
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t
+  use casca_contact, only: contact_t, constraint_t
   use casca_mass_solver, only: mass_solver_t
   use casca_lapack, only: dpotrf, dpotrs
   implicit none
   private
-  public :: contact_correction
+  public :: contact_correction, add_impulses
 
   type :: columns_t
     real(dp), allocatable :: x(:, :)
@@ -30,10 +30,11 @@ module casca_contact_correction
 contains
 
   !> Project v and a (full-length, every rank alike) onto the active constraints' persistent
-  !> contact: C v+ = 0, C a+ = 0. impulse: the velocity's nu (M (v+ - v) = C^T nu).
+  !> contact: C v+ = 0, C a+ = 0. impulse: the velocity's nu (M (v+ - v) = C^T nu); the
+  !> acceleration's is kept in each constraint (mu).
   subroutine contact_correction(ms, c, model, v, a, err, impulse)
     type(mass_solver_t), intent(inout) :: ms
-    type(contact_t), intent(in) :: c
+    type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(inout) :: v(:), a(:)
     type(error_t), allocatable, intent(out) :: err
@@ -74,6 +75,7 @@ contains
     end if
     call dpotrs('L', nc, 2, s, nc, nu, nc, info)
     if (present(impulse)) impulse = nu(:, 1)
+    c%act(1:nc)%mu = nu(:, 2)
     do comp = 1, 3   ! v += M^-1 C^T nu_v, a += M^-1 C^T nu_a
       if (ms%neq(comp) == 0) cycle
       associate (xc => held(comp)%x, d => ms%dofs(1:ms%neq(comp), comp))
@@ -116,4 +118,42 @@ contains
 
   end subroutine contact_correction
 
+
+  !> y = y + M^-1 sum_k amount_k C_k^T over the constraints cons (one MUMPS call per
+  !> distinct matrix): the response of the free bodies to equal and opposite impulses
+  subroutine add_impulses(ms, cons, amount, model, y, err)
+    type(mass_solver_t), intent(inout) :: ms
+    type(constraint_t), intent(in) :: cons(:)
+    real(dp), intent(in) :: amount(:)
+    type(model_t), intent(in) :: model
+    real(dp), intent(inout) :: y(:)
+    type(error_t), allocatable, intent(out) :: err
+    real(dp), allocatable :: b(:, :), x(:, :)
+    integer, allocatable :: comps(:)
+    integer :: sv, j, k, comp, d(11)
+    real(dp) :: val(11)
+    if (size(cons) == 0) return
+    do sv = 1, 3
+      comps = pack([1, 2, 3], ms%solver_of == sv .and. ms%neq > 0)
+      if (size(comps) == 0) cycle
+      allocate (b(ms%neq(sv), size(comps)), x(ms%neq(sv), size(comps)))
+      b = 0
+      do j = 1, size(comps)
+        comp = comps(j)
+        do k = 1, size(cons)
+          d(1) = dof(cons(k)%node, comp); val(1) = cons(k)%n(comp)
+          d(2:) = dof(model%conn(:, cons(k)%elem), comp); val(2:) = -cons(k)%shp*cons(k)%n(comp)
+          where (ms%eq(d) > 0) b(ms%eq(d), j) = b(ms%eq(d), j) + amount(k)*val
+        end do
+      end do
+      call ms%solve(sv, b, x, err)
+      if (allocated(err)) return
+      do j = 1, size(comps)
+        associate (dd => ms%dofs(1:ms%neq(comps(j)), comps(j)))
+          y(dd) = y(dd) + x(1:ms%neq(comps(j)), j)
+        end associate
+      end do
+      deallocate (b, x)
+    end do
+  end subroutine add_impulses
 end module casca_contact_correction

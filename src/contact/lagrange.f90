@@ -26,6 +26,7 @@ module casca_contact
     real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
     real(dp) :: gap = 0, lambda = 0
     real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected
+    real(dp) :: mu = 0          !< the acceleration's correction: M a += C^T mu (after a step)
   end type constraint_t
 
   type :: contact_t

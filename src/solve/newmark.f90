@@ -7,8 +7,8 @@ module casca_newmark
   use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t
-  use casca_contact_correction, only: contact_correction
+  use casca_contact, only: contact_t, constraint_t
+  use casca_contact_correction, only: contact_correction, add_impulses
   implicit none
   private
   public :: state_t, newmark_t, newmark_step, static_solve
@@ -28,6 +28,11 @@ contains
 
   !> One step s -> s+1 with external load fext (dead). On failure st and the contact's
   !> active set are unchanged.
+  !> A contact released in the step would still push through the step's start
+  !> acceleration (its force acts with weight 1 - gamma, 1/2 - beta over the step), which is
+  !> how the trapezoidal rule gains 1/2 p g of energy at every release. Such a step is taken
+  !> again from the start acceleration without the released contacts' net force,
+  !> a + M^-1 C_R^T (lambda_R - mu_R): the force of a contact ends when it opens.
   subroutine newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
@@ -39,32 +44,62 @@ contains
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: qs(:), rs(:), q(:), qd(:), qdd(:)
+    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:)
+    type(constraint_t), allocatable :: before(:), released(:)
     real(dp) :: b, dt, g
+    integer :: k, iters
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
-    allocate (qs, rs, q, qd, qdd, mold=st%q)   ! (not on assignment: gfortran warns, falsely)
-    qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*st%qdd
-    rs = st%qd + dt*(1 - g)*st%qdd
-    ! predictor: the step taken with zero new acceleration
-    q = st%q + dt*st%qd + dt*dt*(0.5_dp - b)*st%qdd
-    where (model%fixed) q = st%q
-    call newton_solve(model, asm, ls, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
-    if (.not. allocated(err) .and. .not. rep%converged) &
-      call fatal_error(err, 'Newton did not converge')
+    a0 = st%qdd
+    if (present(contact)) before = contact%act(1:contact%nact)
+    call attempt()
     if (allocated(err)) return
-    qdd = q/(b*dt*dt) - qs
-    qd = rs + g*dt*qdd
-    if (present(contact)) then   ! (on failure the state is left as it was)
-      call contact_correction(ls%mass, contact, model, qd, qdd, err)
-      if (allocated(err)) return
+    if (present(contact)) then
+      released = [constraint_t ::]
+      do k = 1, size(before)
+        if (.not. any(contact%act(1:contact%nact)%node == before(k)%node .and. &
+                      contact%act(1:contact%nact)%pair == before(k)%pair)) &
+          released = [released, before(k)]
+      end do
+      if (size(released) > 0) then
+        call add_impulses(ls%mass, released, released%lambda - released%mu, model, a0, err)
+        if (allocated(err)) return
+        iters = rep%iters
+        contact%nact = size(before); contact%act(1:size(before)) = before
+        call attempt()
+        if (allocated(err)) then   ! (the state is as it was: the step is cut)
+          contact%nact = size(before); contact%act(1:size(before)) = before
+          return
+        end if
+        rep%iters = rep%iters + iters
+      end if
     end if
-    where (model%fixed)
-      qd = 0; qdd = 0
-    end where
     st%q = q; st%qd = qd; st%qdd = qdd
     st%t = st%t + dt
     st%step = st%step + 1
+  contains
+    !> the step from (st%q, st%qd, a0): q, qd, qdd
+    subroutine attempt()
+      real(dp), allocatable :: qs(:), rs(:)
+      qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*a0
+      rs = st%qd + dt*(1 - g)*a0
+      ! predictor: the step taken with zero new acceleration
+      q = st%q + dt*st%qd + dt*dt*(0.5_dp - b)*a0
+      where (model%fixed) q = st%q
+      call newton_solve(model, asm, ls, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
+      if (.not. allocated(err) .and. .not. rep%converged) &
+        call fatal_error(err, 'Newton did not converge')
+      if (allocated(err)) return
+      qdd = q/(b*dt*dt) - qs
+      qd = rs + g*dt*qdd
+      if (present(contact)) then   ! (on failure the state is left as it was)
+        call contact_correction(ls%mass, contact, model, qd, qdd, err)
+        if (allocated(err)) return
+      end if
+      where (model%fixed)
+        qd = 0; qdd = 0
+      end where
+    end subroutine attempt
   end subroutine newmark_step
 
   !> Statics: the dead load fext scaled from factor from to factor to, in one increment if
