@@ -1,17 +1,28 @@
 !> Numbers as text for messages (one home for what every module that writes messages needs).
 module casca_strings
+  use, intrinsic :: iso_fortran_env, only: int32, int64
   implicit none
   private
   public :: itoa
 
+  !> n as its shortest decimal text (default and 64-bit integers, e.g. HDF5's hsize_t)
+  interface itoa
+    module procedure itoa_i32, itoa_i64
+  end interface itoa
+
 contains
 
-  !> n as its shortest decimal text
-  pure function itoa(n) result(s)
-    integer, intent(in) :: n
+  pure function itoa_i32(n) result(s)
+    integer(int32), intent(in) :: n
     character(len=:), allocatable :: s
-    character(len=16) :: b
+    s = itoa_i64(int(n, int64))
+  end function itoa_i32
+
+  pure function itoa_i64(n) result(s)
+    integer(int64), intent(in) :: n
+    character(len=:), allocatable :: s
+    character(len=24) :: b
     write (b, '(i0)') n
     s = trim(b)
-  end function itoa
+  end function itoa_i64
 end module casca_strings

@@ -41,6 +41,7 @@ module casca_hdf5_io
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_checked_file, only: write_file_atomic
+  use casca_strings, only: itoa
   implicit none
   private
   public :: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, h5_table_close, &
@@ -762,11 +763,4 @@ contains
     if (fid /= -1) call h5fclose_f(fid, h)
   end subroutine abandon
 
-  pure function itoa(n) result(s)
-    integer(hsize_t), intent(in) :: n
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(i0)') n
-    s = trim(buf)
-  end function itoa
 end module casca_hdf5_io

@@ -16,6 +16,7 @@ module casca_vtu_writer
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_files, only: rename_file, close_complete, delete_file
+  use casca_strings, only: itoa
   implicit none
   private
   public :: field_t, field, write_vtu, write_pvd
@@ -31,9 +32,6 @@ module casca_vtu_writer
   integer, parameter :: msg_len = 512
   character(len=*), parameter :: nl = achar(10)
 
-  interface itoa
-    module procedure itoa_i32, itoa_i64
-  end interface itoa
 
 
 contains
@@ -309,17 +307,4 @@ contains
     end do
   end function xml_escape
 
-  pure function itoa_i32(i) result(s)
-    integer(int32), intent(in) :: i
-    character(len=:), allocatable :: s
-    s = itoa_i64(int(i, int64))
-  end function itoa_i32
-
-  pure function itoa_i64(i) result(s)
-    integer(int64), intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(i0)') i
-    s = trim(buf)
-  end function itoa_i64
 end module casca_vtu_writer
