@@ -59,7 +59,7 @@ contains
       do j = 1, ncomp
         call columns(comps(j), b(:, (j - 1)*nc + 1:j*nc))
       end do
-      call ms%solve(sv, b, x, err)
+      call ms%solve_sparse(sv, b, x, err)
       if (allocated(err)) return
       do j = 1, ncomp
         s = s + matmul(transpose(b(:, (j - 1)*nc + 1:j*nc)), x(:, (j - 1)*nc + 1:j*nc))
@@ -146,7 +146,7 @@ contains
           where (ms%eq(d) > 0) b(ms%eq(d), j) = b(ms%eq(d), j) + amount(k)*val
         end do
       end do
-      call ms%solve(sv, b, x, err)
+      call ms%solve_sparse(sv, b, x, err)
       if (allocated(err)) return
       do j = 1, size(comps)
         associate (dd => ms%dofs(1:ms%neq(comps(j)), comps(j)))

@@ -9,6 +9,7 @@ module casca_newmark
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_correction, only: contact_correction, add_impulses
+  use casca_timers, only: timer_start, timer_stop, t_contact
   implicit none
   private
   public :: state_t, newmark_t, newmark_step, static_solve
@@ -32,7 +33,9 @@ contains
   !> acceleration (its force acts with weight 1 - gamma, 1/2 - beta over the step), which is
   !> how the trapezoidal rule gains 1/2 p g of energy at every release. Such a step is taken
   !> again from the start acceleration without the released contacts' net force,
-  !> a + M^-1 C_R^T (lambda_R - mu_R): the force of a contact ends when it opens.
+  !> a + M^-1 C_R^T (lambda_R - mu_R): the force of a contact ends when it opens. With
+  !> gamma >= 1 (the thesis' 1.5) that leftover acts backwards and only dissipates: the step
+  !> is not taken again.
   subroutine newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
@@ -54,7 +57,7 @@ contains
     if (present(contact)) before = contact%act(1:contact%nact)
     call attempt()
     if (allocated(err)) return
-    if (present(contact)) then
+    if (present(contact) .and. g < 1) then   ! (gamma >= 1: what is left pulls back, dissipates)
       released = [constraint_t ::]
       do k = 1, size(before)
         if (.not. any(contact%act(1:contact%nact)%node == before(k)%node .and. &
@@ -62,7 +65,9 @@ contains
           released = [released, before(k)]
       end do
       if (size(released) > 0) then
+        call timer_start(t_contact)
         call add_impulses(ls%mass, released, released%lambda - released%mu, model, a0, err)
+        call timer_stop(t_contact)
         if (allocated(err)) return
         iters = rep%iters
         contact%nact = size(before); contact%act(1:size(before)) = before
@@ -93,7 +98,9 @@ contains
       qdd = q/(b*dt*dt) - qs
       qd = rs + g*dt*qdd
       if (present(contact)) then   ! (on failure the state is left as it was)
+        call timer_start(t_contact)
         call contact_correction(ls%mass, contact, model, qd, qdd, err)
+        call timer_stop(t_contact)
         if (allocated(err)) return
       end if
       where (model%fixed)
