@@ -56,7 +56,12 @@ contains
     a0 = st%qdd
     if (present(contact)) before = contact%act(1:contact%nact)
     call attempt()
-    if (allocated(err)) return
+    if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
+      if (present(contact)) then
+        contact%nact = size(before); contact%act(1:size(before)) = before
+      end if
+      return
+    end if
     if (present(contact) .and. g < 1) then   ! (gamma >= 1: what is left pulls back, dissipates)
       released = [constraint_t ::]
       do k = 1, size(before)
