@@ -57,7 +57,7 @@ contains
       if (ncomp == 0) cycle
       allocate (b(ms%neq(sv), ncomp*nc), x(ms%neq(sv), ncomp*nc))
       do j = 1, ncomp
-        call columns(comps(j), b(:, (j - 1)*nc + 1:j*nc))
+        call constraint_columns(ms, c%act(1:nc), model, comps(j), b(:, (j - 1)*nc + 1:j*nc))
       end do
       call ms%solve_sparse(sv, b, x, err)
       if (allocated(err)) return
@@ -84,24 +84,6 @@ contains
       end associate
     end do
   contains
-    !> B (equations of component comp, nc): the rows of C on that component, as columns
-    subroutine columns(comp, b)
-      integer, intent(in) :: comp
-      real(dp), intent(out) :: b(:, :)
-      integer :: col, j, d(11)
-      real(dp) :: val(11)
-      b = 0
-      do col = 1, nc
-        associate (con => c%act(col))
-          d(1) = dof(con%node, comp); val(1) = con%n(comp)
-          d(2:) = dof(model%conn(:, con%elem), comp); val(2:) = -con%shp*con%n(comp)
-        end associate
-        do j = 1, 11
-          if (ms%eq(d(j)) > 0) b(ms%eq(d(j)), col) = b(ms%eq(d(j)), col) + val(j)
-        end do
-      end do
-    end subroutine columns
-
     !> row k of C times y: the normal relative rate of constraint k
     real(dp) function row_dot(k, y)
       integer, intent(in) :: k
@@ -128,24 +110,20 @@ contains
     type(model_t), intent(in) :: model
     real(dp), intent(inout) :: y(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), allocatable :: b(:, :), x(:, :)
+    real(dp), allocatable :: b(:, :), x(:, :), bk(:, :)
     integer, allocatable :: comps(:)
-    integer :: sv, j, k, comp, d(11)
-    real(dp) :: val(11)
+    integer :: sv, j
     if (size(cons) == 0) return
     do sv = 1, 3
       comps = pack([1, 2, 3], ms%solver_of == sv .and. ms%neq > 0)
       if (size(comps) == 0) cycle
       allocate (b(ms%neq(sv), size(comps)), x(ms%neq(sv), size(comps)))
-      b = 0
+      allocate (bk(ms%neq(sv), size(cons)))
       do j = 1, size(comps)
-        comp = comps(j)
-        do k = 1, size(cons)
-          d(1) = dof(cons(k)%node, comp); val(1) = cons(k)%n(comp)
-          d(2:) = dof(model%conn(:, cons(k)%elem), comp); val(2:) = -cons(k)%shp*cons(k)%n(comp)
-          where (ms%eq(d) > 0) b(ms%eq(d), j) = b(ms%eq(d), j) + amount(k)*val
-        end do
+        call constraint_columns(ms, cons, model, comps(j), bk)
+        b(:, j) = matmul(bk, amount)
       end do
+      deallocate (bk)
       call ms%solve_sparse(sv, b, x, err)
       if (allocated(err)) return
       do j = 1, size(comps)
@@ -156,4 +134,24 @@ contains
       deallocate (b, x)
     end do
   end subroutine add_impulses
+
+  !> B (equations of component comp of ms, one column per constraint): the rows of C on
+  !> that component, n on the impactor node and -N_j n on the target's nodes
+  subroutine constraint_columns(ms, cons, model, comp, b)
+    type(mass_solver_t), intent(in) :: ms
+    type(constraint_t), intent(in) :: cons(:)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: comp
+    real(dp), intent(out) :: b(:, :)
+    integer :: col, j, d(11)
+    real(dp) :: val(11)
+    b = 0
+    do col = 1, size(cons)
+      d(1) = dof(cons(col)%node, comp); val(1) = cons(col)%n(comp)
+      d(2:) = dof(model%conn(:, cons(col)%elem), comp); val(2:) = -cons(col)%shp*cons(col)%n(comp)
+      do j = 1, 11
+        if (ms%eq(d(j)) > 0) b(ms%eq(d(j)), col) = b(ms%eq(d(j)), col) + val(j)
+      end do
+    end do
+  end subroutine constraint_columns
 end module casca_contact_correction
