@@ -7,7 +7,7 @@
 !> right-hand sides have a few nonzeros each (the nodes of a constraint), so M^-1 is applied
 !> through cached columns M^-1 e_i of the equations touched: a contact patch that stays in
 !> place costs no solve after its first step (three spheres: the correction's time from
-!> 13 s to ATIME).
+!> 13 s to 2.9 s of a 58 s run).
 module casca_mass_solver
   use casca_kinds, only: dp
   use casca_error, only: error_t
