@@ -36,7 +36,6 @@ module casca_mass_solver
     integer :: solver_of(3) = [1, 2, 3]  !< components with the same restraints share one
     type(column_cache_t) :: cache(3)     !< per system
   contains
-    procedure :: solve => mass_solve
     procedure :: solve_sparse => mass_solve_sparse
     procedure :: finish => mass_finish
   end type mass_solver_t
@@ -100,17 +99,7 @@ contains
     end function param_dof
   end subroutine mass_setup
 
-  !> x = m^-1 b for the system of solver s (b, x: (its neq, nrhs))
-  subroutine mass_solve(self, s, b, x, err)
-    class(mass_solver_t), intent(inout) :: self
-    integer, intent(in) :: s
-    real(dp), intent(in) :: b(:, :)
-    real(dp), intent(out) :: x(:, :)
-    type(error_t), allocatable, intent(out) :: err
-    call self%m(s)%solve(b, x, err)
-  end subroutine mass_solve
-
-  !> x = m^-1 b as mass_solve, for b with few nonzero rows: x = sum_i b(i, :) M^-1 e_i,
+  !> x = m^-1 b for system s (b, x: (its neq, nrhs)), b with few nonzero rows: x = sum_i b(i, :) M^-1 e_i,
   !> the columns missing from the cache solved at once and kept
   subroutine mass_solve_sparse(self, s, b, x, err)
     class(mass_solver_t), intent(inout) :: self
