@@ -17,7 +17,9 @@ program test_correction
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_newmark, only: state_t
   use casca_accounting, only: balance_t, account
-  use casca_contact, only: contact_t, contact_init, contact_update
+  use casca_contact, only: contact_t, contact_init
+  use casca_contact_active_set, only: contact_update
+  use casca_obstacle, only: obstacle_t
   use casca_mass_solver, only: mass_solver_t, mass_setup
   use casca_contact_correction, only: contact_correction
   use casca_vectors, only: cross
@@ -52,7 +54,7 @@ program test_correction
   allocate (st%q(model%ndof), zero(model%ndof))
   call reference_state(model, st%q)
   zero = 0
-  call contact_init(model, reshape([1, 2], [2, 1]), 1e-9_dp, c)
+  call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
   call contact_update(c, model, st%q, .true., added)
   call check_true('overlapping rings: several constraints found', c%nact >= 3)
   ! arbitrary smooth velocities and accelerations on every parameter

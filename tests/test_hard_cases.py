@@ -27,6 +27,7 @@ def rings(name, v=10.0, dt=5e-5, t_end=0.03, center="2.01, 0.0, 0.0", thickness=
   {STEEL}, thickness = {thickness} /
 &body name = 'ring2', mesh = 'file', file = '{ring}', center = {center},
   {STEEL}, thickness = {thickness} /
+&contact surface = 'mid' /
 """)
     out = os.path.join(work, name)
     p = run([casca, "run", deck, "--out", out, "-q"])
@@ -122,6 +123,7 @@ with open(deck, "w") as f:
 &body name = 'plate', mesh = 'file', file = '{plate}', rotate_axis = 1.0, 0.0, 0.0,
   rotate_angle = -90.0, center = -1.5, -1.01, 0.5, {STEEL}, thickness = 0.05 /
 &restraint body = 'plate', fix = 'all' /
+&contact surface = 'mid' /
 """)
 out = os.path.join(work, "drop")
 p = run([casca, "run", deck, "--out", out, "-q"])

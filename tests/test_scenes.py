@@ -165,7 +165,7 @@ body = ("&body name = 'sphere%%d', mesh = 'file', file = '%s', center = %%g, 0, 
 deck = os.path.join(work, "two_spheres.nml")
 with open(deck, "w") as f:
     f.write("&run dt = 6.0e-6, t_end = 8.5e-3 /\n&output vtu = .false., plots = .false. /\n"
-            + body % (1, 0.0, v0) + body % (2, 2.01, 0.0))
+            + body % (1, 0.0, v0) + body % (2, 2.01, 0.0) + "&contact surface = 'mid' /\n")
 out = os.path.join(work, "two_spheres")
 p = run([casca, "run", deck, "--out", out, "-q"], np_ranks=2)
 ck.record("two spheres (8.5 ms, 2 ranks) run to completion (exit 0)", p.returncode == 0,

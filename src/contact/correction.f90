@@ -17,6 +17,7 @@ module casca_contact_correction
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof
   use casca_contact, only: contact_t, constraint_t
+  use casca_contact_projection, only: constraint_entries
   use casca_mass_solver, only: mass_solver_t
   use casca_lapack, only: dpotrf, dpotrs
   implicit none
@@ -46,7 +47,8 @@ contains
     nc = c%nact
     if (nc == 0) return
     allocate (s(nc, nc), nu(nc, 2))
-    nu(:, 1) = -[(row_dot(k, v), k=1, nc)]
+    ! (against a moving obstacle the node keeps the obstacle's normal speed)
+    nu(:, 1) = -[(row_dot(k, v) - obstacle_rate(k), k=1, nc)]
     nu(:, 2) = -[(row_dot(k, a), k=1, nc)]
     ! S = sum over components of B^T M^-1 B (B: the component's part of C^T, as columns);
     ! X = M^-1 B is kept: the corrections are X nu. One MUMPS call per distinct matrix.
@@ -88,15 +90,23 @@ contains
     real(dp) function row_dot(k, y)
       integer, intent(in) :: k
       real(dp), intent(in) :: y(:)
-      integer :: j
-      associate (con => c%act(k))
-        row_dot = dot_product(con%n, y(dof(con%node, 1):dof(con%node, 3)))
-        do j = 1, 10
-          row_dot = row_dot - con%shp(j)*dot_product(con%n, &
-                    y(dof(model%conn(j, con%elem), 1):dof(model%conn(j, con%elem), 3)))
-        end do
-      end associate
+      integer :: j, nodes(11), nn
+      real(dp) :: w(11)
+      call constraint_entries(c%act(k), model, nodes, w, nn)
+      row_dot = 0
+      do j = 1, nn
+        row_dot = row_dot + w(j)*dot_product(c%act(k)%n, y(dof(nodes(j), 1):dof(nodes(j), 3)))
+      end do
     end function row_dot
+
+    !> normal speed of the obstacle constraint k presses on (0 for a body)
+    real(dp) function obstacle_rate(k)
+      integer, intent(in) :: k
+      integer :: t
+      t = c%pair(2, c%act(k)%pair)
+      obstacle_rate = 0
+      if (t <= 0) obstacle_rate = dot_product(c%act(k)%n, c%obstacle(-t)%velocity)
+    end function obstacle_rate
 
   end subroutine contact_correction
 
@@ -143,14 +153,14 @@ contains
     type(model_t), intent(in) :: model
     integer, intent(in) :: comp
     real(dp), intent(out) :: b(:, :)
-    integer :: col, j, d(11)
-    real(dp) :: val(11)
+    integer :: col, j, nodes(11), nn, d
+    real(dp) :: w(11)
     b = 0
     do col = 1, size(cons)
-      d(1) = dof(cons(col)%node, comp); val(1) = cons(col)%n(comp)
-      d(2:) = dof(model%conn(:, cons(col)%elem), comp); val(2:) = -cons(col)%shp*cons(col)%n(comp)
-      do j = 1, 11
-        if (ms%eq(d(j)) > 0) b(ms%eq(d(j)), col) = b(ms%eq(d(j)), col) + val(j)
+      call constraint_entries(cons(col), model, nodes, w, nn)
+      do j = 1, nn
+        d = ms%eq(dof(nodes(j), comp))
+        if (d > 0) b(d, col) = b(d, col) + w(j)*cons(col)%n(comp)
       end do
     end do
   end subroutine constraint_columns

@@ -202,13 +202,17 @@ contains
   !> Nearest sub-triangle to p among those at distance <= rmax (found = .false. if none), the
   !> same itri, q, bary, dist and region as nearest_all_pairs. x must be the coordinates the
   !> grid was built with. grid is inout only for its visited stamps.
-  subroutine nearest_subtriangle(surf, grid, x, p, rmax, found, itri, q, bary, dist, region)
+  !> With ref, pref and rskip (self-contact), the sub-triangles with a vertex whose position in
+  !> ref lies within rskip of pref are left out.
+  subroutine nearest_subtriangle(surf, grid, x, p, rmax, found, itri, q, bary, dist, region, &
+                                 ref, pref, rskip)
     type(surface_t), intent(in) :: surf
     type(grid_t), intent(inout) :: grid
     real(dp), intent(in) :: x(:, :), p(3), rmax
     logical, intent(out) :: found
     integer, intent(out) :: itri, region
     real(dp), intent(out) :: q(3), bary(3), dist
+    real(dp), intent(in), optional :: ref(:, :), pref(3), rskip
     real(dp) :: tol, g(3), t, gsum, bound, f, e, lim2
     integer :: c(3), lo(3), hi(3), k, i, j, l, d
 
@@ -246,13 +250,13 @@ contains
           if (abs(i - c(1)) == k .or. abs(j - c(2)) == k) then
             do l = lo(3), hi(3)
               call scan_cell(surf, grid, x, p, rmax, tol, cell_id(grid, i, j, l), lim2, &
-                             found, itri, q, bary, dist, region)
+                             found, itri, q, bary, dist, region, ref, pref, rskip)
             end do
           else
             if (c(3) - k >= 0) call scan_cell(surf, grid, x, p, rmax, tol, cell_id(grid, i, j, c(3) - k), &
-                                              lim2, found, itri, q, bary, dist, region)
+                                              lim2, found, itri, q, bary, dist, region, ref, pref, rskip)
             if (c(3) + k <= grid%n(3) - 1) call scan_cell(surf, grid, x, p, rmax, tol, &
-                cell_id(grid, i, j, c(3) + k), lim2, found, itri, q, bary, dist, region)
+                cell_id(grid, i, j, c(3) + k), lim2, found, itri, q, bary, dist, region, ref, pref, rskip)
           end if
         end do
       end do
@@ -281,7 +285,8 @@ contains
   !> Examine the entries of cell cid: box pre-test (the box distance is a lower bound of the
   !> sub-triangle's), then each sub-triangle once per query; keep the best (ties: smaller itri).
   !> lim2 = (min(dist, rmax) + tol)^2 is the pre-test's limit.
-  subroutine scan_cell(surf, grid, x, p, rmax, tol, cid, lim2, found, itri, q, bary, dist, region)
+  subroutine scan_cell(surf, grid, x, p, rmax, tol, cid, lim2, found, itri, q, bary, dist, region, &
+                       ref, pref, rskip)
     type(surface_t), intent(in) :: surf
     type(grid_t), intent(inout) :: grid
     real(dp), intent(in) :: x(:, :), p(3), rmax, tol
@@ -290,6 +295,7 @@ contains
     logical, intent(inout) :: found
     integer, intent(inout) :: itri, region
     real(dp), intent(inout) :: q(3), bary(3), dist
+    real(dp), intent(in), optional :: ref(:, :), pref(3), rskip
     real(dp) :: qt(3), bt(3), dt, bd2
     integer :: pos, it, reg
 
@@ -301,6 +307,10 @@ contains
       it = grid%entry_tri(pos)
       if (grid%stamp(it) == grid%query) cycle
       grid%stamp(it) = grid%query
+      if (present(rskip)) then
+        if (any([norm2(ref(:, surf%tri(1, it)) - pref), norm2(ref(:, surf%tri(2, it)) - pref), &
+                 norm2(ref(:, surf%tri(3, it)) - pref)] < rskip)) cycle
+      end if
       call eval_subtri(surf, x, it, p, qt, bt, dt, reg)
       if (dt > rmax) cycle
       if (found) then

@@ -5,7 +5,7 @@ module casca_run
   use casca_error, only: error_t
   use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
-  use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs
+  use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs, scene_obstacles
   use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
@@ -16,8 +16,10 @@ module casca_run
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
                           output_flush, output_release
   use casca_vtu_writer, only: field_t, field
-  use casca_contact, only: contact_t, contact_init, contact_force_total, contact_nodal_fields, &
-                           contact_penetration, contact_signed_distance, contact_update
+  use casca_contact, only: contact_t, contact_init
+  use casca_contact_active_set, only: contact_update
+  use casca_contact_rows, only: contact_force_total, contact_nodal_fields
+  use casca_contact_probes, only: contact_penetration, contact_signed_distance
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
   use casca_free_flight, only: idle_bodies, advance_idle
@@ -59,10 +61,11 @@ contains
       real(dp), allocatable :: q(:)
       integer, allocatable :: pairs(:, :)
       integer :: added, k, worst
-      character(len=256) :: msg
+      character(len=512) :: msg
       allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
       if (size(pairs, 2) == 0) return
-      call contact_init(model, pairs, deck%contact%tolerance*model%length, probe)
+      call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
+                        deck%contact%surface == 'faces', probe)
       allocate (q(model%ndof))
       call reference_state(model, q)
       call contact_update(probe, model, q, .true., added)
@@ -71,11 +74,24 @@ contains
       k = probe%act(worst)%node
       write (msg, '(a,a,a,a,a,i0,a,es10.3,a,i0,a)') 'bodies ''', &
         trim(model%body(model%node_body(k))%name), ''' and ''', &
-        trim(model%body(pairs(2, probe%act(worst)%pair))%name), ''' overlap at the start: node ', &
+        trim(target_name(pairs(2, probe%act(worst)%pair))), ''' overlap at the start: node ', &
         k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, &
         ' m inside (', added, ' nodes in all); move them apart'
+      if (probe%faces) msg = trim(msg)//' (contact is between the shell faces: half of each '// &
+                             'thickness from the mid-surface)'
       call add_problem(deck, 0, trim(msg))
     end subroutine check_overlap
+
+    !> a body's name, or an obstacle's (target -k)
+    function target_name(t) result(name)
+      integer, intent(in) :: t
+      character(len=:), allocatable :: name
+      if (t > 0) then
+        name = model%body(t)%name
+      else
+        name = deck%obstacles(-t)%name
+      end if
+    end function target_name
   end subroutine load_scene
 
   subroutine run_deck(path, out_dir, restart, quiet, code)
@@ -238,6 +254,7 @@ contains
       logical, allocatable :: fz(:)
       integer :: b
       if (use_contact) then
+        contact%time = st%t
         call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle, contact)
       else
         call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle)
@@ -283,7 +300,8 @@ contains
       use_contact = size(pairs, 2) > 0
       ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
       if (use_contact) then
-        call contact_init(model, pairs, deck%contact%tolerance*model%length, contact)
+        call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
+                          deck%contact%surface == 'faces', contact)
         if (deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
         contact%nodal_normal = deck%contact%normal == 'nodal'
       end if

@@ -4,7 +4,8 @@
 !>   &body       (one per body) mesh or generator, material, thickness, initial motion
 !>   &restraint  (any number) prescribed parameters of a body's nodes: a box or a node set
 !>   &load       (any number) a dead force shared by a body's nodes: a box or a node set
-!>   &contact    contact pairs and tolerances
+!>   &contact    contact pairs, surfaces and tolerances
+!>   &obstacle   (any number) a rigid plane, sphere or cylinder, fixed or moving
 !> Every problem found while reading is collected (file:line: group: message) so that the
 !> user sees them all at once; nothing here stops the program.
 module casca_deck
@@ -15,7 +16,7 @@ module casca_deck
   implicit none
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
-  public :: contact_cfg_t, read_deck, add_problem, max_track, unset, deck_file
+  public :: contact_cfg_t, obstacle_cfg_t, read_deck, add_problem, max_track, unset, deck_file
 
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
@@ -26,8 +27,8 @@ module casca_deck
   integer, parameter :: long = 1024
   integer, parameter :: max_line_len = 4096
   real(dp), parameter :: unset = -huge(1._dp)   !< marks a value the deck did not give
-  character(len=*), parameter :: known_groups(7) = &
-    [character(len=9) :: 'run', 'output', 'body', 'restraint', 'load', 'contact', 'end']
+  character(len=*), parameter :: known_groups(8) = &
+    [character(len=9) :: 'run', 'output', 'body', 'restraint', 'load', 'contact', 'obstacle', 'end']
 
   type :: run_cfg_t
     character(len=128) :: title = ''
@@ -94,8 +95,24 @@ module casca_deck
     real(dp) :: tolerance = 1e-7_dp             !< penetration accepted, relative to scene size
     character(len=16) :: solver = 'schur'       !< 'schur' or 'saddle' (docs/method.md)
     character(len=16) :: normal = 'nodal'       !< 'nodal' or 'element' (docs/method.md)
+    character(len=16) :: surface = 'faces'      !< 'faces' (thickness offset) or 'mid'
+    integer :: passes = 1                       !< 2: each body of a pair impacts the other too
     integer :: line = 0
   end type contact_cfg_t
+
+  type :: obstacle_cfg_t
+    character(len=64) :: name = ''
+    character(len=16) :: shape = ''             !< plane, sphere, cylinder
+    real(dp) :: point(3) = 0                    !< plane: a point; sphere: centre; cylinder: on the axis
+    real(dp) :: normal(3) = 0                   !< plane: towards the bodies
+    real(dp) :: axis(3) = 0                     !< cylinder
+    real(dp) :: radius = unset
+    logical :: inside = .false.                 !< sphere, cylinder: the bodies are inside
+    real(dp) :: velocity(3) = 0
+    integer :: nbodies = 0                      !< 0: every body
+    character(len=64) :: bodies(max_pairs) = ''
+    integer :: line = 0
+  end type obstacle_cfg_t
 
   type :: deck_t
     character(len=:), allocatable :: path
@@ -106,6 +123,7 @@ module casca_deck
     type(restraint_cfg_t), allocatable :: restraints(:)
     type(load_cfg_t), allocatable :: loads(:)
     type(contact_cfg_t) :: contact
+    type(obstacle_cfg_t), allocatable :: obstacles(:)
     integer :: nproblems = 0
     character(len=512), allocatable :: problems(:)
   end type deck_t
@@ -173,7 +191,7 @@ contains
     deck%path = path
     k = index(path, '/', back=.true.)
     deck%base_dir = path(1:k)
-    allocate (deck%bodies(0), deck%restraints(0), deck%loads(0))
+    allocate (deck%bodies(0), deck%restraints(0), deck%loads(0), deck%obstacles(0))
     if (file_kind(path) == kind_special .or. file_kind(path) == kind_folder) then
       call add_problem(deck, 0, 'the deck is not a regular file (a folder, FIFO or device)')
       return
@@ -193,6 +211,7 @@ contains
     call read_bodies(u, deck)
     call read_restraints(u, deck)
     call read_loads(u, deck)
+    call read_obstacles(u, deck)
     close (u)
     if (count(gname == 'run') > 1) call add_problem(deck, line_of('run', 2), '&run given twice')
     if (count(gname == 'output') > 1) &
@@ -307,6 +326,40 @@ contains
         dk%loads = [dk%loads, l]
       end do
     end subroutine read_loads
+
+    subroutine read_obstacles(uu, dk)
+      integer, intent(in) :: uu
+      type(deck_t), intent(inout) :: dk
+      character(len=long) :: name, shape
+      character(len=256) :: bodies(max_pairs)
+      real(dp) :: point(3), normal(3), axis(3), radius, velocity(3)
+      logical :: inside
+      namelist /obstacle/ name, shape, point, normal, axis, radius, inside, velocity, bodies
+      type(obstacle_cfg_t) :: o
+      integer :: io, k
+      rewind (uu)
+      do io = 1, count(gname == 'obstacle')
+        o = obstacle_cfg_t()
+        name = o%name; shape = o%shape; point = o%point; normal = o%normal; axis = o%axis
+        radius = o%radius; inside = o%inside; velocity = o%velocity; bodies = ''
+        read (uu, nml=obstacle, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+          call add_problem(dk, line_of('obstacle', io), '&obstacle: '//trim(msg))
+          return
+        end if
+        o%line = line_of('obstacle', io)
+        call take(dk, o%line, '&obstacle: name', name, o%name)
+        call take(dk, o%line, '&obstacle: shape', lower(shape), o%shape)
+        o%point = point; o%normal = normal; o%axis = axis; o%radius = radius
+        o%inside = inside; o%velocity = velocity
+        do k = 1, max_pairs
+          if (bodies(k) == '') exit
+          o%nbodies = k
+          call take(dk, o%line, '&obstacle: bodies', bodies(k), o%bodies(k))
+        end do
+        dk%obstacles = [dk%obstacles, o]
+      end do
+    end subroutine read_obstacles
   end subroutine read_deck
 
   !> Names and lines of every '&group' in the file; unknown names are problems (a misspelt
@@ -344,7 +397,7 @@ contains
       name = lower(line(2:j))
       if (all(known_groups /= name)) then
         call add_problem(deck, n, 'unknown group &'//trim(name)// &
-                         ' (known: &run, &output, &body, &restraint, &load, &contact)')
+                         ' (known: &run, &output, &body, &restraint, &load, &contact, &obstacle)')
         cycle
       end if
       if (name == 'end') cycle
@@ -436,14 +489,15 @@ contains
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
     logical :: enabled
-    character(len=long) :: solver, normal
+    character(len=long) :: solver, normal, surface
     character(len=256) :: pairs(2, max_pairs)   ! (longer than a name: enough to see one too long)
     real(dp) :: tolerance
     character(len=256) :: msg
-    integer :: ios, k
-    namelist /contact/ enabled, pairs, tolerance, solver, normal
+    integer :: ios, k, passes
+    namelist /contact/ enabled, pairs, tolerance, solver, normal, surface, passes
     associate (c => deck%contact)
       enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver; normal = c%normal
+      surface = c%surface; passes = c%passes
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -454,6 +508,8 @@ contains
       c%enabled = enabled; c%tolerance = tolerance
       call take(deck, line, '&contact: solver', lower(solver), c%solver)
       call take(deck, line, '&contact: normal', lower(normal), c%normal)
+      call take(deck, line, '&contact: surface', lower(surface), c%surface)
+      c%passes = passes
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit

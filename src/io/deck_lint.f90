@@ -48,9 +48,16 @@ contains
       end select
     case ('contact')
       select case (key)
-      case ('pairs', 'solver', 'normal'); t = 's'
+      case ('pairs', 'solver', 'normal', 'surface'); t = 's'
       case ('tolerance'); t = 'r'
+      case ('passes'); t = 'i'
       case ('enabled'); t = 'l'
+      end select
+    case ('obstacle')
+      select case (key)
+      case ('name', 'shape', 'bodies'); t = 's'
+      case ('point', 'normal', 'axis', 'radius', 'velocity'); t = 'r'
+      case ('inside'); t = 'l'
       end select
     end select
   end function key_type

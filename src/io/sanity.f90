@@ -3,7 +3,7 @@
 module casca_sanity
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use casca_kinds, only: dp
-  use casca_deck, only: deck_t, add_problem, unset, deck_file
+  use casca_deck, only: deck_t, obstacle_cfg_t, add_problem, unset, deck_file
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
   use casca_mesh_generators, only: generated_elements, max_generated_elements
   use casca_strings, only: itoa
@@ -171,9 +171,6 @@ contains
     end do
     call check_memory()
     do j = 1, deck%contact%npairs
-      if (deck%contact%pairs(1, j) == deck%contact%pairs(2, j)) call add_problem(deck, &
-        deck%contact%line, '&contact: pairs(:, '//itoa(j)//') pairs '''// &
-        trim(deck%contact%pairs(1, j))//''' with itself; self-contact is not supported')
       do i = 1, 2
         if (find_body(deck%contact%pairs(i, j)) == 0) then
           write (ns, '(i0)') j
@@ -187,7 +184,48 @@ contains
       call add_problem(deck, deck%contact%line, '&contact: solver must be ''schur'' or ''saddle''')
     if (deck%contact%normal /= 'nodal' .and. deck%contact%normal /= 'element') &
       call add_problem(deck, deck%contact%line, '&contact: normal must be ''nodal'' or ''element''')
+    if (deck%contact%surface /= 'faces' .and. deck%contact%surface /= 'mid') &
+      call add_problem(deck, deck%contact%line, '&contact: surface must be ''faces'' or ''mid''')
+    if (deck%contact%passes /= 1 .and. deck%contact%passes /= 2) &
+      call add_problem(deck, deck%contact%line, '&contact: passes must be 1 or 2')
+    do i = 1, size(deck%obstacles)
+      call check_obstacle(deck%obstacles(i))
+    end do
   contains
+    subroutine check_obstacle(o)
+      type(obstacle_cfg_t), intent(in) :: o
+      integer :: k
+      if (o%name == '') call add_problem(deck, o%line, '&obstacle: name is missing')
+      if (find_body(o%name) > 0) call add_problem(deck, o%line, '&obstacle: name = '''// &
+        trim(o%name)//''' is also a body''s name')
+      call finite(o%line, '&obstacle: point', o%point)
+      call finite(o%line, '&obstacle: velocity', o%velocity)
+      select case (o%shape)
+      case ('plane')
+        call unit_vector(o%line, '&obstacle: normal', o%normal)
+      case ('sphere')
+        call positive(o%line, '&obstacle: radius', o%radius)
+      case ('cylinder')
+        call unit_vector(o%line, '&obstacle: axis', o%axis)
+        call positive(o%line, '&obstacle: radius', o%radius)
+      case default
+        call add_problem(deck, o%line, '&obstacle: shape = '''//trim(o%shape)// &
+                         ''' (use plane, sphere or cylinder)')
+      end select
+      do k = 1, o%nbodies
+        if (find_body(o%bodies(k)) == 0) call add_problem(deck, o%line, '&obstacle: bodies names '''// &
+          trim(o%bodies(k))//''', which is not a body of the deck')
+      end do
+    end subroutine check_obstacle
+
+    subroutine unit_vector(line, field, v)
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: field
+      real(dp), intent(in) :: v(3)
+      call finite(line, field, v)
+      if (.not. (norm2(v) > 0)) call add_problem(deck, line, field//' must be a non-zero vector')
+    end subroutine unit_vector
+
     subroutine positive(line, field, v)
       integer, intent(in) :: line
       character(len=*), intent(in) :: field

@@ -11,9 +11,10 @@ module casca_scene
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
   use casca_newmark, only: state_t
   use casca_vectors, only: cross
+  use casca_obstacle, only: obstacle_t
   implicit none
   private
-  public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs
+  public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles
 
 contains
 
@@ -174,31 +175,78 @@ contains
     end function body_label
   end subroutine build_model
 
-  !> Contact pairs (impactor, target) of the deck: those it lists, or every pair of bodies
-  !> with the earlier one impacting. None when contact is off or there is one body.
+  !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),
+  !> or every pair of bodies with the earlier one impacting; with passes = 2 each body pair
+  !> also the other way round; then each obstacle's bodies against it (target -k: obstacle k).
+  !> None when contact is off.
   function contact_pairs(deck, model) result(pairs)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
     integer, allocatable :: pairs(:, :)
-    integer :: i, j, p
+    integer :: i, j, p, k, np
     allocate (pairs(2, 0))
-    if (.not. deck%contact%enabled .or. model%nbody < 2) return
+    if (.not. deck%contact%enabled) return
     if (deck%contact%npairs > 0) then
-      deallocate (pairs); allocate (pairs(2, deck%contact%npairs))
       do p = 1, deck%contact%npairs
-        do j = 1, 2
-          pairs(j, p) = findloc([(model%body(i)%name == deck%contact%pairs(j, p), &
-                                  i=1, model%nbody)], .true., dim=1)
-        end do
+        call add(body_index(deck%contact%pairs(1, p)), body_index(deck%contact%pairs(2, p)))
       end do
     else
       do i = 1, model%nbody
         do j = i + 1, model%nbody
-          pairs = reshape([pairs, i, j], [2, size(pairs, 2) + 1])
+          call add(i, j)
         end do
       end do
     end if
+    if (deck%contact%passes == 2) then
+      np = size(pairs, 2)
+      do p = 1, np
+        if (pairs(1, p) /= pairs(2, p)) call add(pairs(2, p), pairs(1, p))
+      end do
+    end if
+    do k = 1, size(deck%obstacles)
+      associate (o => deck%obstacles(k))
+        if (o%nbodies == 0) then
+          do i = 1, model%nbody
+            call add(i, -k)
+          end do
+        else
+          do p = 1, o%nbodies
+            call add(body_index(o%bodies(p)), -k)
+          end do
+        end if
+      end associate
+    end do
+  contains
+    subroutine add(a, b)
+      integer, intent(in) :: a, b
+      integer :: m
+      do m = 1, size(pairs, 2)   ! (a pair listed twice is one pair)
+        if (pairs(1, m) == a .and. pairs(2, m) == b) return
+      end do
+      pairs = reshape([pairs, a, b], [2, size(pairs, 2) + 1])
+    end subroutine add
+
+    integer function body_index(name)
+      character(len=*), intent(in) :: name
+      body_index = findloc([(model%body(i)%name == name, i=1, model%nbody)], .true., dim=1)
+    end function body_index
   end function contact_pairs
+
+  !> The deck's rigid obstacles, their normal and axis made unit vectors.
+  function scene_obstacles(deck) result(obs)
+    type(deck_t), intent(in) :: deck
+    type(obstacle_t), allocatable :: obs(:)
+    integer :: k
+    allocate (obs(size(deck%obstacles)))
+    do k = 1, size(obs)
+      associate (o => deck%obstacles(k))
+        obs(k)%name = o%name; obs(k)%shape = o%shape; obs(k)%point = o%point
+        obs(k)%radius = o%radius; obs(k)%inside = o%inside; obs(k)%velocity = o%velocity
+        if (o%shape == 'plane') obs(k)%normal = o%normal/norm2(o%normal)
+        if (o%shape == 'cylinder') obs(k)%normal = o%axis/norm2(o%axis)
+      end associate
+    end do
+  end function scene_obstacles
 
   !> Unstressed initial state moving with each body's velocity and spin (about its centroid).
   subroutine initial_state(deck, model, st)

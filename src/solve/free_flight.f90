@@ -6,7 +6,8 @@
 module casca_free_flight
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t
+  use casca_contact, only: contact_t, pair_offset
+  use casca_obstacle, only: obstacle_point
   implicit none
   private
   public :: idle_bodies, advance_idle
@@ -20,7 +21,8 @@ contains
     logical, intent(out) :: idle(:)
     type(contact_t), intent(in), optional :: contact
     real(dp) :: lo(3, model%nbody), hi(3, model%nbody), speed(model%nbody), reach
-    real(dp) :: shift(3), v(3), tol, x(3)
+    real(dp) :: shift(3), v(3), tol, x(3), nrm(3), d
+    logical :: near
     integer :: b, n, k, i, j, f, l
     tol = 1e-12_dp*model%length
     do b = 1, model%nbody
@@ -46,16 +48,31 @@ contains
     if (.not. present(contact)) return
     do k = 1, contact%nact   ! bodies in contact
       i = model%node_body(contact%act(k)%node)
-      idle(i) = .false.; idle(contact%pair(2, contact%act(k)%pair)) = .false.
+      idle(i) = .false.
+      j = contact%pair(2, contact%act(k)%pair)
+      if (j > 0) idle(j) = .false.
     end do
     do k = 1, contact%npairs  ! an impactor node that could reach the target within two steps
       i = contact%pair(1, k); j = contact%pair(2, k)
-      if (.not. (idle(i) .or. idle(j))) cycle
-      reach = 2*dt*(speed(i) + speed(j)) + contact%tol
+      if (j > 0) then
+        if (.not. (idle(i) .or. idle(j))) cycle
+        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + 1.25_dp*pair_offset(contact, model, i, j)
+      else
+        if (.not. idle(i)) cycle
+        reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%tol + &
+                1.25_dp*pair_offset(contact, model, i, j)
+      end if
       do n = model%body(i)%node_first, model%body(i)%node_last
         x = q(dof(n, 1):dof(n, 3))
-        if (all(x <= hi(:, j) + reach) .and. all(x >= lo(:, j) - reach)) then
-          idle(i) = .false.; idle(j) = .false.
+        if (j > 0) then
+          near = all(x <= hi(:, j) + reach) .and. all(x >= lo(:, j) - reach)
+        else
+          call obstacle_point(contact%obstacle(-j), contact%time, x, nrm, d)
+          near = d <= reach
+        end if
+        if (near) then
+          idle(i) = .false.
+          if (j > 0) idle(j) = .false.
           exit
         end if
       end do

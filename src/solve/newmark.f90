@@ -54,7 +54,10 @@ contains
 
     b = nm%beta; g = nm%gamma; dt = nm%dt
     a0 = st%qdd
-    if (present(contact)) before = contact%act(1:contact%nact)
+    if (present(contact)) then
+      before = contact%act(1:contact%nact)
+      contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
+    end if
     call attempt()
     if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
       if (present(contact)) then

@@ -23,8 +23,9 @@ module casca_newton
   use casca_assembly, only: assembly_t, assemble
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
                                  kkt_solve, negative_pivots
-  use casca_contact, only: contact_t, constraint_t, contact_update, contact_release, contact_rows, &
-                           contact_nodal_fields
+  use casca_contact, only: contact_t, constraint_t
+  use casca_contact_active_set, only: contact_update, contact_release
+  use casca_contact_rows, only: contact_rows, contact_nodal_fields
   use casca_mpi, only: is_root, sum_all
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve

@@ -1,0 +1,171 @@
+!> The active set: which impactor nodes carry a constraint. Detection adds the nodes that
+!> penetrate their target; release drops the constraints whose multiplier turned tensile.
+module casca_contact_active_set
+  use casca_kinds, only: dp
+  use casca_model, only: model_t, dof
+  use casca_obstacle, only: obstacle_point
+  use casca_contact, only: contact_t, constraint_t, search_radius, pair_offset
+  use casca_contact_projection, only: positions, body_box, project, constraint_geometry
+  implicit none
+  private
+  public :: contact_update, contact_release
+
+contains
+
+  !> Refresh the active constraints (normal and gap at their point; with reproject, the point
+  !> itself: nearest sub-triangle again) and, with detect, add the penetrating nodes that are
+  !> not yet active. Holding the point in late Newton iterations avoids flip-flopping between
+  !> two elements at a kink of the C0 surface. Returns the number of constraints added.
+  subroutine contact_update(c, model, q, detect, added, reproject)
+    type(contact_t), intent(inout) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    logical, intent(in) :: detect
+    integer, intent(out) :: added
+    logical, intent(in), optional :: reproject
+    real(dp), allocatable :: x(:, :)
+    real(dp) :: boxi(3, 2), boxt(3, 2), r, reach, nrm(3), d
+    integer :: ip, bi, bt, n, k
+    logical :: found
+    type(constraint_t) :: cn
+
+    added = 0
+    allocate (x(3, model%nnode))
+    x = positions(model, q)
+    c%geo%grid_ok = .false.
+    ! active constraints: project again (the target moves and the node slides)
+    do k = 1, c%nact
+      if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
+        if (present(reproject)) then
+          if (.not. reproject) then
+            call constraint_geometry(c, model, x, q, c%act(k)); cycle
+          end if
+        end if
+        call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
+        if (found) then
+          c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd
+        end if   ! (else far from every sub-triangle within reach: keep the last point)
+      else if (c%pair(2, c%act(k)%pair) > 0) then   ! restored from a checkpoint
+        call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
+        if (found) then
+          c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd
+        else
+          c%act(k)%lambda = 1   ! nothing to press on: released at the next release
+          c%act(k)%elem = 0; cycle
+        end if
+      end if
+      call constraint_geometry(c, model, x, q, c%act(k))
+    end do
+    if (.not. detect) return
+    do ip = 1, c%npairs
+      bi = c%pair(1, ip); bt = c%pair(2, ip)
+      boxi = body_box(model, x, bi)
+      if (bt <= 0) then   ! an obstacle: every node, by its distance
+        reach = 1.25_dp*pair_offset(c, model, bi, bt) + c%tol
+        do n = model%body(bi)%node_first, model%body(bi)%node_last
+          call obstacle_point(c%obstacle(-bt), c%time, x(:, n), nrm, d)
+          if (d > reach) cycle
+          if (is_active(n, ip) .or. all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
+          cn = constraint_t(node=n, pair=ip)
+          call take(cn)
+        end do
+        cycle
+      end if
+      r = search_radius(c, model, bi, bt)
+      boxt = body_box(model, x, bt)
+      ! bodies whose boxes (the target's grown by the search radius) are apart cost nothing
+      if (any(boxi(:, 1) > boxt(:, 2) + r) .or. any(boxi(:, 2) < boxt(:, 1) - r)) cycle
+      ! the sub-triangles are chords of the cubic surface: they find the candidates, the
+      ! constraint's own gap decides (else a node released with zero gap would be taken
+      ! again at once where the chord lies outside the surface). A cubic arc bulges from
+      ! its chord e by kappa e^2 / 8, below a quarter of depth = e / 2 while kappa e < 1
+      reach = 1.25_dp*pair_offset(c, model, bi, bt) + 0.25_dp*c%geo%depth(bt)
+      do n = model%body(bi)%node_first, model%body(bi)%node_last
+        if (any(x(:, n) > boxt(:, 2) + r) .or. any(x(:, n) < boxt(:, 1) - r)) cycle
+        if (is_active(n, ip)) cycle
+        call project(c, model, x, n, ip, cn, found)
+        if (.not. found) cycle
+        if (cn%sd >= reach .or. .not. has_free_position(n, cn%elem)) cycle
+        if (redundant(cn)) cycle
+        call take(cn)
+      end do
+    end do
+    if (added > 0) c%changes = c%changes + 1
+  contains
+    !> add cn if its gap is beyond the tolerance
+    subroutine take(cn)
+      type(constraint_t), intent(inout) :: cn
+      call constraint_geometry(c, model, x, q, cn)
+      if (cn%gap < -c%tol) then
+        call push(cn)
+        added = added + 1
+      end if
+    end subroutine take
+
+    logical function is_active(node, p)
+      integer, intent(in) :: node, p
+      integer :: j
+      is_active = .false.
+      do j = 1, c%nact
+        if (c%act(j)%node == node .and. c%act(j)%pair == p) then
+          is_active = .true.; return
+        end if
+      end do
+    end function is_active
+
+    !> a constraint needs at least one free position on either side
+    logical function has_free_position(node, e)
+      integer, intent(in) :: node, e
+      has_free_position = .not. (all(model%fixed(dof(node, 1):dof(node, 3))) .and. &
+                            all(model%fixed(dof(model%conn(:, e), 1))) .and. &
+                            all(model%fixed(dof(model%conn(:, e), 2))) .and. &
+                            all(model%fixed(dof(model%conn(:, e), 3))))
+    end function has_free_position
+
+    !> Two-pass contact: node i pressed on an element of the other body that holds node j,
+    !> while j is already pressed on an element that holds i, repeats j's row (the same two
+    !> points along the same normal): the saddle point would turn singular, so it is left out
+    logical function redundant(cn)
+      type(constraint_t), intent(in) :: cn
+      integer :: j
+      redundant = .false.
+      do j = 1, c%nact
+        associate (o => c%act(j))
+          if (o%elem == 0) cycle
+          if (c%pair(1, o%pair) /= c%pair(2, cn%pair) .or. c%pair(2, o%pair) /= c%pair(1, cn%pair)) cycle
+          if (any(model%conn(:, cn%elem) == o%node) .and. any(model%conn(:, o%elem) == cn%node)) then
+            redundant = .true.; return
+          end if
+        end associate
+      end do
+    end function redundant
+
+    subroutine push(con)
+      type(constraint_t), intent(in) :: con
+      type(constraint_t), allocatable :: tmp(:)
+      if (c%nact == size(c%act)) then
+        allocate (tmp(2*size(c%act)))
+        tmp(1:c%nact) = c%act(1:c%nact)
+        call move_alloc(tmp, c%act)
+      end if
+      c%nact = c%nact + 1
+      c%act(c%nact) = con
+    end subroutine push
+  end subroutine contact_update
+
+  !> Release the constraints whose multiplier is tensile (lambda > 0); how many were released.
+  subroutine contact_release(c, released)
+    type(contact_t), intent(inout) :: c
+    integer, intent(out) :: released
+    integer :: k, m
+    m = 0
+    do k = 1, c%nact
+      if (c%act(k)%lambda > 0) cycle
+      m = m + 1
+      c%act(m) = c%act(k)
+    end do
+    released = c%nact - m
+    c%nact = m
+    if (released > 0) c%changes = c%changes + 1
+  end subroutine contact_release
+end module casca_contact_active_set

@@ -1,0 +1,159 @@
+!> Non-penetration by Lagrange multipliers (thesis ch. 5): what a contact problem is made of.
+!> A pair is (impactor body, target): a body (itself for self-contact) or a rigid obstacle.
+!> Every impactor node that penetrates its target gets one multiplier lambda and the condition
+!>     g = (x_imp - x_target(xi)) . n(xi) - offset = 0,   x_target = N_j(xi) Y^j,
+!> linearised with xi, n and the offset held (eq. 5.6). lambda < 0 is compression (the force
+!> on the impactor is -lambda n); a multiplier that turns tensile at convergence is released.
+!> The jobs live in their own files: projection.f90 (the point, normal and gap of one
+!> constraint), active_set.f90 (detection and release), rows.f90 (C, forces), correction.f90
+!> (the velocity after a step), probes.f90 (diagnostics).
+module casca_contact
+  use casca_kinds, only: dp
+  use casca_model, only: model_t
+  use casca_shape_tri10, only: tri10_shape, tri10_node_xi
+  use casca_surface_search, only: surface_t, grid_t, surface_init
+  use casca_obstacle, only: obstacle_t
+  implicit none
+  private
+  public :: contact_t, constraint_t, target_geometry_t, contact_init, pair_offset, search_radius
+
+  type :: constraint_t
+    integer :: node = 0, pair = 0
+    integer :: elem = 0         !< target element; 0: an obstacle, or not projected yet (restart)
+    integer :: side = 0         !< side of a two-sided target the node is on (+-1), 0: not known
+    real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
+    real(dp) :: gap = 0, lambda = 0
+    real(dp) :: off = 0         !< face offset held in the linearisation (0 between mid-surfaces)
+    real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected
+    real(dp) :: mu = 0          !< the acceleration's correction: M a += C^T mu (after a step)
+  end type constraint_t
+
+  !> The target bodies' surfaces as the search and the normals need them.
+  type :: target_geometry_t
+    type(surface_t), allocatable :: surf(:)     !< per body (only targets are built)
+    real(dp), allocatable :: depth(:)           !< per body: half the mean sub-triangle edge
+    real(dp), allocatable :: skip(:)            !< per body: self-contact ignores its surface
+                                                !< within this reference distance of the node
+    type(grid_t), allocatable :: grid(:)        !< per pair: the target near the impactor
+    logical, allocatable :: grid_ok(:)          !< grid of this pair rebuilt for this q
+    ! the target elements at node n: node_elem(node_start(n) : node_start(n+1) - 1), and which
+    ! of their nodes n is (node_loc); shape derivatives at the 10 nodes (dphi_node)
+    integer, allocatable :: node_start(:), node_elem(:), node_loc(:)
+    real(dp) :: dphi_node(10, 2, 10) = 0
+  end type target_geometry_t
+
+  type :: contact_t
+    ! options
+    real(dp) :: tol = 0                         !< penetration accepted [m]
+    logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
+    logical :: faces = .true.                   !< contact at the shell faces, else mid-surfaces
+    ! the problem
+    integer :: npairs = 0
+    integer, allocatable :: pair(:, :)          !< (2, npairs) impactor body, target: a body,
+                                                !< or -k for obstacle k
+    type(obstacle_t), allocatable :: obstacle(:)
+    real(dp) :: time = 0                        !< obstacles are where they are at this time
+    type(target_geometry_t) :: geo
+    ! the active set
+    integer :: nact = 0
+    type(constraint_t), allocatable :: act(:)
+    integer :: changes = 0                      !< active-set changes in this step
+  end type contact_t
+
+contains
+
+  !> pairs(2, npairs): impactor and target of each pair (-k: obstacle k of obstacles).
+  !> tol: accepted penetration [m]; faces: contact at the shell faces.
+  subroutine contact_init(model, pairs, obstacles, tol, faces, c)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: pairs(:, :)
+    type(obstacle_t), intent(in) :: obstacles(:)
+    real(dp), intent(in) :: tol
+    logical, intent(in) :: faces
+    type(contact_t), intent(out) :: c
+    integer :: b, e, k, n
+    real(dp) :: edge, phi(10), diam
+    logical, allocatable :: target_elem(:)
+    c%npairs = size(pairs, 2)
+    c%pair = pairs
+    c%obstacle = obstacles
+    c%tol = tol
+    c%faces = faces
+    allocate (c%act(16))
+    associate (g => c%geo)
+      allocate (g%surf(model%nbody), g%grid(c%npairs), g%grid_ok(c%npairs), g%depth(model%nbody), &
+                g%skip(model%nbody))
+      g%grid_ok = .false.; g%depth = 0; g%skip = 0
+      do b = 1, model%nbody
+        if (.not. any(pairs(2, :) == b)) cycle
+        associate (bd => model%body(b))
+          call surface_init(model%conn, [(e, e=bd%elem_first, bd%elem_last)], g%surf(b))
+          ! half the mean sub-triangle edge: a node deeper than that is behind the surface,
+          ! not through it (matters at the rim of open surfaces)
+          edge = 0
+          do k = 1, g%surf(b)%ntri
+            edge = edge + norm2(model%x0(:, g%surf(b)%tri(1, k)) - model%x0(:, g%surf(b)%tri(2, k)))
+          end do
+          g%depth(b) = 0.5_dp*edge/g%surf(b)%ntri
+          ! self-contact: the elements at the node (within the largest element's size) and
+          ! the surface the search could reach from the node's own place are never targets
+          diam = 0
+          do e = bd%elem_first, bd%elem_last
+            do k = 1, 3
+              diam = max(diam, norm2(model%x0(:, model%conn(k, e)) - model%x0(:, model%conn(mod(k, 3) + 1, e))))
+            end do
+          end do
+          g%skip(b) = max(1.01_dp*diam, 1.5_dp*search_radius(c, model, b, b))
+        end associate
+      end do
+      ! the elements of the targets at each node (counted, then filled)
+      allocate (target_elem(model%nelem), g%node_start(model%nnode + 1))
+      target_elem = .false.
+      do b = 1, model%nbody
+        if (any(pairs(2, :) == b)) target_elem(model%body(b)%elem_first:model%body(b)%elem_last) = .true.
+      end do
+      g%node_start = 0
+      do e = 1, model%nelem
+        if (target_elem(e)) g%node_start(model%conn(:, e) + 1) = g%node_start(model%conn(:, e) + 1) + 1
+      end do
+      g%node_start(1) = 1
+      do n = 1, model%nnode
+        g%node_start(n + 1) = g%node_start(n + 1) + g%node_start(n)
+      end do
+      allocate (g%node_elem(g%node_start(model%nnode + 1) - 1), g%node_loc(g%node_start(model%nnode + 1) - 1))
+      do e = 1, model%nelem
+        if (.not. target_elem(e)) cycle
+        do k = 1, 10
+          n = model%conn(k, e)
+          g%node_elem(g%node_start(n)) = e; g%node_loc(g%node_start(n)) = k
+          g%node_start(n) = g%node_start(n) + 1
+        end do
+      end do
+      g%node_start(2:) = g%node_start(1:model%nnode); g%node_start(1) = 1
+      do k = 1, 10
+        call tri10_shape(tri10_node_xi(1, k), tri10_node_xi(2, k), phi, g%dphi_node(:, :, k))
+      end do
+    end associate
+  end subroutine contact_init
+
+  !> The faces' distance between the mid-surfaces of impactor bi and target bt (a body, or
+  !> <= 0: an obstacle) in the initial state: half of each thickness; 0 between mid-surfaces
+  pure real(dp) function pair_offset(c, model, bi, bt)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: bi, bt
+    pair_offset = 0
+    if (.not. c%faces) return
+    pair_offset = 0.5_dp*model%body(bi)%thickness
+    if (bt > 0) pair_offset = pair_offset + 0.5_dp*model%body(bt)%thickness
+  end function pair_offset
+
+  !> How far from the target's mid-surface (bt > 0) a node of bi is looked for: the faces'
+  !> offset (with room for the fibre's stretch) and the band below the surface
+  pure real(dp) function search_radius(c, model, bi, bt)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: bi, bt
+    search_radius = 1.25_dp*pair_offset(c, model, bi, bt) + c%geo%depth(bt)
+  end function search_radius
+end module casca_contact

@@ -1,0 +1,63 @@
+!> Rigid obstacles given by a few numbers: a plane, a sphere or a cylinder (infinite), fixed or
+!> translating at a prescribed velocity. A node meets an obstacle at its closest point; the
+!> normal points to the side the bodies are on, so the signed distance is the gap of the
+!> mid-surface (the face offset is added by the caller).
+module casca_obstacle
+  use casca_kinds, only: dp
+  implicit none
+  private
+  public :: obstacle_t, obstacle_point, obstacle_kinds
+
+  character(len=*), parameter :: obstacle_kinds(3) = [character(len=8) :: 'plane', 'sphere', 'cylinder']
+
+  type :: obstacle_t
+    character(len=64) :: name = ''
+    character(len=8) :: shape = 'plane'
+    real(dp) :: point(3) = 0      !< plane: a point of it; sphere: centre; cylinder: a point of the axis
+    real(dp) :: normal(3) = 0     !< plane: unit normal towards the bodies; cylinder: unit axis
+    real(dp) :: radius = 0
+    logical :: inside = .false.   !< sphere, cylinder: the bodies are inside (a container)
+    real(dp) :: velocity(3) = 0   !< prescribed translation [m/s]
+  end type obstacle_t
+
+contains
+
+  !> At time t: the unit normal n at the point of the obstacle closest to x (towards the
+  !> bodies' side) and the signed distance d of x from it (negative: x is in the obstacle).
+  pure subroutine obstacle_point(ob, t, x, n, d)
+    type(obstacle_t), intent(in) :: ob
+    real(dp), intent(in) :: t, x(3)
+    real(dp), intent(out) :: n(3), d
+    real(dp) :: c(3), r(3), rn
+    c = ob%point + t*ob%velocity
+    select case (ob%shape)
+    case ('plane')
+      n = ob%normal
+      d = dot_product(x - c, n)
+      return
+    case ('sphere')
+      r = x - c
+    case default   ! cylinder: the part of x - c across the axis
+      r = (x - c) - dot_product(x - c, ob%normal)*ob%normal
+    end select
+    rn = norm2(r)
+    if (rn > 0) then
+      n = r/rn
+    else   ! on the centre or the axis: any direction across
+      n = [1, 0, 0]
+      if (ob%shape == 'cylinder') n = unit_across(ob%normal)
+    end if
+    d = rn - ob%radius
+    if (ob%inside) then
+      n = -n; d = -d
+    end if
+  end subroutine obstacle_point
+
+  pure function unit_across(a) result(u)
+    real(dp), intent(in) :: a(3)
+    real(dp) :: u(3)
+    u = [a(2), -a(1), 0._dp]
+    if (norm2(u) < 0.5_dp) u = [0._dp, a(3), -a(2)]
+    u = u/norm2(u)
+  end function unit_across
+end module casca_obstacle
