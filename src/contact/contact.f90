@@ -23,7 +23,10 @@ module casca_contact
     integer :: side = 0         !< side of a two-sided target the node is on (+-1), 0: not known
     real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
     real(dp) :: gap = 0, lambda = 0
-    real(dp) :: off = 0         !< face offset held in the linearisation (0 between mid-surfaces)
+    real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)
+    !> the offset's derivatives: d off = dg(1) n.dG_node + dg(2) dA_node
+    !>                                  + sum_j N_j (dg(3) n.dG_j + dg(4) dA_j) (target nodes)
+    real(dp) :: dg(4) = 0
     real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected
     real(dp) :: mu = 0          !< the acceleration's correction: M a += C^T mu (after a step)
   end type constraint_t

@@ -88,13 +88,16 @@ contains
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: x(:, :), q(:)
     type(constraint_t), intent(inout) :: con
-    real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3), gm, gt(3), at
+    real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3), gm, gt(3), at, fi, ft
     integer :: j, i, nd, bi, bt
     bi = c%pair(1, con%pair); bt = c%pair(2, con%pair)
     if (bt <= 0) then
       con%elem = 0; con%side = 1; con%shp = 0
       call obstacle_point(c%obstacle(-bt), c%time, x(:, con%node), con%n, gm)
-      con%off = node_face(con%n)
+      con%off = 0; con%dg = 0
+      if (c%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
+                             q(dof(con%node, 7)), -con%n, con%off, con%dg(1:2))
+      con%dg(1) = -con%dg(1)   ! (the derivative along -n, turned to n)
       con%gap = gm - con%off
       return
     end if
@@ -127,7 +130,7 @@ contains
       if (c%faces) con%side = int(sign(1._dp, gm))
     end if
     con%n = con%side*con%n
-    con%off = 0
+    con%off = 0; con%dg = 0
     if (c%faces) then
       gt = 0; at = 0
       do j = 1, 10
@@ -135,27 +138,26 @@ contains
         gt = gt + con%shp(j)*q(dof(nd, 4):dof(nd, 6))
         at = at + con%shp(j)*q(dof(nd, 7))
       end do
-      con%off = node_face(con%n) + face(model%body(bt)%thickness, gt, at, con%n)
+      ! the impactor's face towards the target (along -n), the target's towards the node
+      call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), q(dof(con%node, 7)), &
+                -con%n, fi, con%dg(1:2))
+      call face(model%body(bt)%thickness, gt, at, con%n, ft, con%dg(3:4))
+      con%dg(1) = -con%dg(1)
+      con%off = fi + ft
     end if
     con%gap = con%side*gm - con%off
-  contains
-    !> how far the impactor node's face towards the target lies behind its mid-surface
-    real(dp) function node_face(nn)
-      real(dp), intent(in) :: nn(3)
-      node_face = 0
-      if (c%faces) node_face = face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
-                                    q(dof(con%node, 7)), -nn)
-    end function node_face
   end subroutine constraint_geometry
 
-  !> Distance along u of the face that lies farthest along u: max over s = +-1 of
-  !> (h/2)(s + a) G.u = (h/2)(|G.u| + a G.u)
-  pure real(dp) function face(h, g, a, u)
+  !> Distance f along u of the face that lies farthest along u: max over s = +-1 of
+  !> (h/2)(s + a) G.u = (h/2)(|G.u| + a G.u), and its derivatives: df = d(1) u.dG + d(2) da
+  pure subroutine face(h, g, a, u, f, d)
     real(dp), intent(in) :: h, g(3), a, u(3)
+    real(dp), intent(out) :: f, d(2)
     real(dp) :: k
     k = dot_product(g, u)
-    face = 0.5_dp*h*(abs(k) + a*k)
-  end function face
+    f = 0.5_dp*h*(abs(k) + a*k)
+    d = 0.5_dp*h*[sign(1._dp, k) + a, k]
+  end subroutine face
 
   !> The nodes a constraint acts on and the weights of its row of C: n on the impactor node,
   !> -N_j n on the target element's nodes (none for an obstacle). m: how many.

@@ -3,11 +3,13 @@
 module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t
+  use casca_contact, only: contact_t, constraint_t
   use casca_contact_projection, only: constraint_entries
   implicit none
   private
-  public :: contact_rows, contact_force_total, contact_nodal_fields
+  public :: contact_rows, contact_generalized_force, contact_force_total, contact_nodal_fields
+
+  integer, parameter :: max_row = 77   !< 11 nodes x (Y, G, A)
 
 contains
 
@@ -19,24 +21,68 @@ contains
     integer, intent(in) :: eq(:), neq
     integer, allocatable, intent(out) :: irn(:), jcn(:)
     real(dp), allocatable, intent(out) :: val(:), gap(:)
-    integer :: k, j, comp, m, nodes(11), nn, e
-    real(dp) :: w(11)
-    allocate (irn(34*c%nact), jcn(34*c%nact), val(34*c%nact), gap(c%nact))
+    integer :: k, j, m, nd, d(max_row)
+    real(dp) :: v(max_row)
+    allocate (irn((max_row + 1)*c%nact), jcn((max_row + 1)*c%nact), val((max_row + 1)*c%nact), &
+              gap(c%nact))
     m = 0
     do k = 1, c%nact
       gap(k) = c%act(k)%gap
-      call constraint_entries(c%act(k), model, nodes, w, nn)
-      do comp = 1, 3
-        do j = 1, nn
-          e = eq(dof(nodes(j), comp))
-          if (e == 0) cycle   ! prescribed parameter: no column
-          m = m + 1; irn(m) = neq + k; jcn(m) = e; val(m) = w(j)*c%act(k)%n(comp)
-        end do
+      call constraint_row(c%act(k), model, d, v, nd)
+      do j = 1, nd
+        if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
+        m = m + 1; irn(m) = neq + k; jcn(m) = eq(d(j)); val(m) = v(j)
       end do
       m = m + 1; irn(m) = neq + k; jcn(m) = neq + k; val(m) = 0
     end do
     irn = irn(1:m); jcn = jcn(1:m); val = val(1:m)
   end subroutine contact_rows
+
+  !> f = C^T lambda (ndof): the multipliers' generalized force, fibres and thicknesses included
+  subroutine contact_generalized_force(c, model, f)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(out) :: f(:)
+    integer :: k, nd, d(max_row)
+    real(dp) :: v(max_row)
+    f = 0
+    do k = 1, c%nact
+      call constraint_row(c%act(k), model, d, v, nd)
+      f(d(1:nd)) = f(d(1:nd)) + c%act(k)%lambda*v(1:nd)
+    end do
+  end subroutine contact_generalized_force
+
+  !> Row of C of one constraint as parameters d(1:nd) and values v(1:nd): the mid-surface
+  !> points along n, and with faces the offset's dependence on the fibres and thicknesses
+  subroutine constraint_row(a, model, d, v, nd)
+    type(constraint_t), intent(in) :: a
+    type(model_t), intent(in) :: model
+    integer, intent(out) :: d(max_row), nd
+    real(dp), intent(out) :: v(max_row)
+    integer :: j, comp, nodes(11), nn
+    real(dp) :: w(11), wf
+    nd = 0
+    call constraint_entries(a, model, nodes, w, nn)
+    do comp = 1, 3
+      do j = 1, nn
+        call put(dof(nodes(j), comp), w(j)*a%n(comp))
+      end do
+    end do
+    if (all(a%dg == 0)) return
+    do j = 1, nn   ! d gap = -d off
+      wf = merge(1._dp, -w(j), j == 1)   ! (N_j at the target's nodes)
+      do comp = 1, 3
+        call put(dof(nodes(j), 3 + comp), -wf*a%dg(merge(1, 3, j == 1))*a%n(comp))
+      end do
+      call put(dof(nodes(j), 7), -wf*a%dg(merge(2, 4, j == 1)))
+    end do
+  contains
+    subroutine put(dd, vv)
+      integer, intent(in) :: dd
+      real(dp), intent(in) :: vv
+      nd = nd + 1; d(nd) = dd; v(nd) = vv
+    end subroutine put
+  end subroutine constraint_row
 
   !> Total normal contact force (sum of the compressive multipliers).
   pure real(dp) function contact_force_total(c)

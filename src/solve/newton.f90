@@ -25,7 +25,7 @@ module casca_newton
                                  kkt_solve, negative_pivots
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_active_set, only: contact_update, contact_release
-  use casca_contact_rows, only: contact_rows, contact_nodal_fields
+  use casca_contact_rows, only: contact_rows, contact_generalized_force
   use casca_mpi, only: is_root, sum_all
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve
@@ -171,15 +171,10 @@ contains
     !> res = r + C^T lambda on the free parameters, its largest entry rnorm, and the scale of
     !> the scene's forces: the loads, the internal and inertial force, the multipliers' force
     subroutine full_residual()
-      real(dp), allocatable :: fc(:, :)
-      integer :: n
       res = r
-      if (nc > 0) then   ! C^T lambda is minus the nodal contact force
-        allocate (fc(3, model%nnode))
-        call contact_nodal_fields(contact, model, fc)
-        do n = 1, model%nnode
-          res(dof(n, 1):dof(n, 3)) = res(dof(n, 1):dof(n, 3)) - fc(:, n)
-        end do
+      if (nc > 0) then   ! + C^T lambda: on the fibres and thicknesses too, with faces
+        call contact_generalized_force(contact, model, res)
+        res = r + res
       end if
       where (model%fixed) res = 0
       rnorm = maxval(abs(res))
