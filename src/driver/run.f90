@@ -12,7 +12,7 @@ module casca_run
   use casca_mass_solver, only: mass_setup
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
-  use casca_accounting, only: balance_t, account, gravity_load, balance_summary
+  use casca_accounting, only: balance_t, account, gravity_load, balance_summary, energy_balance
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
                           output_flush, output_release
   use casca_vtu_writer, only: field_t, field
@@ -20,6 +20,7 @@ module casca_run
   use casca_contact_active_set, only: contact_update
   use casca_contact_rows, only: contact_force_total, contact_nodal_fields
   use casca_contact_probes, only: contact_penetration, contact_signed_distance
+  use casca_pair_report, only: pair_normal_force, pair_active_count, pair_labels
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
   use casca_free_flight, only: idle_bodies, advance_idle
@@ -161,7 +162,19 @@ contains
       if (failed('restart')) return
       restart_step = st%step
     end if
-    call output_open(out, dir, tracked, labels, restart_step, st%t, err)
+    block   ! the history's per-body and per-pair columns are named after these
+      character(len=64), allocatable :: body_names(:)   ! (the deck's longest name)
+      character(len=:), allocatable :: pair_names(:)
+      body_names = [character(len=64) :: (model%body(k)%name, k=1, model%nbody)]
+      if (use_contact) then
+        ! targets -k are obstacles: names from -size(obstacles) up, then the bodies
+        call pair_labels(contact%pair, [character(len=64) :: (deck%obstacles(-k)%name, &
+                         k=-size(deck%obstacles), -1), '-', body_names], -size(deck%obstacles), pair_names)
+      else
+        allocate (character(len=1) :: pair_names(0))
+      end if
+      call output_open(out, dir, tracked, labels, body_names, pair_names, restart_step, st%t, err)
+    end block
     if (failed('output')) return
 
     t0 = wall_time(); t_start = st%t
@@ -315,9 +328,11 @@ contains
         call contact_penetration(contact, model, st%q, pen, gmax)
         if (contact%nact > 0) lmax = maxval(contact%act(1:contact%nact)%lambda)
         call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
-                            max(pen, 0._dp), rep%neg_pivots, lmax, gmax, err)
+                            max(pen, 0._dp), rep%neg_pivots, lmax, gmax, &
+                            pair_normal_force(contact), pair_active_count(contact), err)
       else
-        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, 0._dp, 0._dp, err)
+        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, 0._dp, 0._dp, &
+                            [real(dp) ::], [integer ::], err)
       end if
     end subroutine history_row
 
@@ -407,8 +422,10 @@ contains
         print '(a,i0,a,a,a,a)', 'done: ', st%step, ' steps in ', seconds(wall_time() - t0), &
           ' s; results in ', dir
         print '(a)', timer_report(wall_time() - t0)
-        if (deck%run%analysis /= 'static' .and. restart_step < 0) &
+        if (deck%run%analysis /= 'static' .and. restart_step < 0) then
           print '(a)', balance_summary(bal0, bal, model%length)
+          print '(a)', energy_balance(bal0, bal)
+        end if
       end if
     end subroutine finish
 

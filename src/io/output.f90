@@ -1,6 +1,7 @@
 !> What a run leaves in its output folder (rank 0 writes, the others pass):
 !>   frame_NNNNN.vtu + run.pvd   ParaView frames with their times
-!>   history.dat + history.h5     one row per step: energies, momenta, contacts, tracked nodes
+!>   history.dat + history.h5     one row per step: energies, momenta, contacts, tracked nodes,
+!>                                energies per body, force and contacts per contact pair
 !>   tracked.txt                  a label per tracked node (for the plots)
 module casca_output
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -33,22 +34,29 @@ module casca_output
     character(len=32), allocatable :: files(:)
     real(dp), allocatable :: times(:)
     integer, allocatable :: tracked(:)
+    integer :: nbody = 0, npairs = 0    !< per-body and per-pair columns
     integer :: rows = 0
     logical :: locked = .false.         !< this run holds the folder's lock
   end type output_t
 
-  integer, parameter :: max_line = 16384   !< longest history.dat line read back at a restart
+  integer, parameter :: max_line = 65536   !< longest history.dat line read back at a restart
+  integer, parameter :: col_len = 160      !< longest column name: prefix and two 64-character names
 
 contains
 
-  !> Column names of the history (also the header of history.dat).
-  function history_columns(ntrack) result(cols)
+  !> Column names of the history (also the header of history.dat): the fixed ones, the
+  !> tracked nodes', then per body (kinetic_B, strain_B) and per contact pair (fcontact_P,
+  !> contacts_P); the per-body and per-pair columns come last, so that the older ones keep
+  !> their positions. Names are single words of letters, digits and '_' (anything else in a
+  !> body's name becomes '_'), which numpy's genfromtxt(names=True) keeps as they are.
+  function history_columns(ntrack, bodies, pairs) result(cols)
     integer, intent(in) :: ntrack
-    character(len=16), allocatable :: cols(:)
+    character(len=*), intent(in) :: bodies(:), pairs(:)
+    character(len=col_len), allocatable :: cols(:)
     character(len=*), parameter :: suffix(6) = [character(len=3) :: '_x', '_y', '_z', '_vx', '_vy', '_vz']
     character(len=8) :: p
     integer :: k, c
-    cols = [character(len=16) :: 't', 'step', 'kinetic', 'strain', 'work', 'total', 'px', 'py', &
+    cols = [character(len=col_len) :: 't', 'step', 'kinetic', 'strain', 'work', 'total', 'px', 'py', &
             'pz', 'Lx', 'Ly', 'Lz', 'contacts', 'fcontact', 'newton', 'penetration', 'neg_pivots', &
             'lambda_max', 'gap_max']
     do k = 1, ntrack
@@ -57,26 +65,43 @@ contains
         cols = [cols, trim(p)//trim(suffix(c))]
       end do
     end do
+    cols = [cols, (word('kinetic_'//trim(bodies(k))), k=1, size(bodies)), &
+            (word('strain_'//trim(bodies(k))), k=1, size(bodies)), &
+            (word('fcontact_'//trim(pairs(k))), k=1, size(pairs)), &
+            (word('contacts_'//trim(pairs(k))), k=1, size(pairs))]
+  contains
+    !> name with every character but letters, digits and '_' replaced by '_'
+    pure function word(name) result(w)
+      character(len=*), intent(in) :: name
+      character(len=col_len) :: w
+      integer :: i
+      w = name
+      do i = 1, len_trim(w)
+        if (verify(w(i:i), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') /= 0) &
+          w(i:i) = '_'
+      end do
+    end function word
   end function history_columns
 
   !> Create the folder, lock it (casca_output_lock) and make the files; with restart_step >= 0
   !> keep what an earlier run wrote up to that step (and the frames up to restart_time) and
-  !> append after it.
-  subroutine output_open(out, dir, tracked, labels, restart_step, restart_time, err)
+  !> append after it. bodies: the bodies' names; pairs: a label per contact pair.
+  subroutine output_open(out, dir, tracked, labels, bodies, pairs, restart_step, restart_time, err)
     type(output_t), intent(out) :: out
     character(len=*), intent(in) :: dir
     integer, intent(in) :: tracked(:)
-    character(len=*), intent(in) :: labels(:)
+    character(len=*), intent(in) :: labels(:), bodies(:), pairs(:)
     integer, intent(in) :: restart_step
     real(dp), intent(in) :: restart_time
     type(error_t), allocatable, intent(out) :: err
-    character(len=16), allocatable :: cols(:)
+    character(len=col_len), allocatable :: cols(:)
     character(len=:), allocatable :: note
     integer :: ios
     character(len=256) :: msg
 
     out%dir = trim(dir)
     out%tracked = tracked
+    out%nbody = size(bodies); out%npairs = size(pairs)
     allocate (out%files(0), out%times(0))
     if (.not. is_root()) return
     if (.not. make_dir(out%dir)) then
@@ -88,7 +113,7 @@ contains
     if (note /= '') write (0, '(a)') 'warning: '//note
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
-    cols = history_columns(size(tracked))
+    cols = history_columns(size(tracked), bodies, pairs)
     if (restart_step < 0) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return
@@ -217,14 +242,17 @@ contains
   !> node without constraint, negative pivots of the last factorisation (the inertia of the
   !> saddle-point matrix: one per active constraint), the most tensile multiplier and the
   !> largest |gap| of the active constraints (the contact conditions at the accepted step),
-  !> tracked nodes.
+  !> tracked nodes, kinetic and strain energy per body (bal), normal force and active
+  !> constraints per contact pair (pair_force, pair_count: as many as output_open's pairs).
   subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, &
-                            lambda_max, gap_max, err)
+                            lambda_max, gap_max, pair_force, pair_count, err)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
     integer, intent(in) :: contacts, newton, neg_pivots
     real(dp), intent(in) :: fcontact, penetration, lambda_max, gap_max
+    real(dp), intent(in) :: pair_force(:)
+    integer, intent(in) :: pair_count(:)
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: row(:)
     character(len=max_line) :: line
@@ -237,6 +265,14 @@ contains
       n = out%tracked(k)
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]
     end do
+    if (size(bal%body_kinetic) /= out%nbody .or. size(pair_force) /= out%npairs .or. &
+        size(pair_count) /= out%npairs) then
+      call fatal_error(err, 'output_history: '//itoa(size(bal%body_kinetic))//' bodies and '// &
+                       itoa(size(pair_force))//' pairs, the history has '//itoa(out%nbody)// &
+                       ' and '//itoa(out%npairs))
+      return
+    end if
+    row = [row, bal%body_kinetic, bal%body_strain, pair_force, real(pair_count, dp)]
     write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
     call cf_write(out%hist, trim(line)//new_line('a'), err)
     if (allocated(err)) return

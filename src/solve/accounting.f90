@@ -1,20 +1,29 @@
 !> Energy and momentum of a state: kinetic energy, strain energy, work of the dead loads,
-!> linear and angular momentum, all from the constant consistent mass (no lumping).
+!> linear and angular momentum, all from the constant consistent mass (no lumping); kinetic
+!> and strain energy also per body, the totals being their sums.
 module casca_accounting
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_assembly, only: assembly_t, strain_energy
+  use casca_assembly, only: assembly_t, strain_energy_local
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
   use casca_vectors, only: cross
   implicit none
   private
-  public :: balance_t, account, gravity_load, balance_summary
+  public :: balance_t, energy_term_t, account, gravity_load, balance_summary, energy_balance
 
   type :: balance_t
     real(dp) :: kinetic = 0, strain = 0, work = 0, total = 0
     real(dp) :: p(3) = 0, l(3) = 0
+    real(dp), allocatable :: body_kinetic(:), body_strain(:)   !< (nbody); kinetic, strain: sums
   end type balance_t
+
+  !> A named share of the initial energy taken out of the bodies (positive: removed), for
+  !> energy_balance: friction, work done on obstacles, ...
+  type :: energy_term_t
+    character(len=:), allocatable :: name
+    real(dp) :: value = 0
+  end type energy_term_t
 
 contains
 
@@ -25,24 +34,30 @@ contains
     type(state_t), intent(in) :: st
     real(dp), intent(in) :: fext(:), q0(:)
     type(balance_t), intent(out) :: bal
-    real(dp) :: x(3, 20), v(3, 20), mv(3, 20), s(7)
-    integer :: i, e, p
+    real(dp) :: x(3, 20), v(3, 20), mv(3, 20)
+    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), p, L: one reduction
+    integer :: i, e, p, b, nb
 
-    bal%strain = strain_energy(model, asm, st%q)
+    nb = model%nbody
+    allocate (s(2*nb + 6))
     s = 0
+    call strain_energy_local(model, asm, st%q, s(nb + 1:2*nb))
     do i = 1, size(asm%owned)   ! every body: frozen ones move too
       e = asm%owned(i)
       call vectors(st%q, e, x)
       call vectors(st%qd, e, v)
       mv = matmul(v, model%emass(:, :, e))
-      s(1) = s(1) + 0.5_dp*sum(v*mv)
-      s(2:4) = s(2:4) + sum(mv(:, 1:10), dim=2)
+      b = model%elem_body(e)
+      s(b) = s(b) + 0.5_dp*sum(v*mv)
+      s(2*nb + 1:2*nb + 3) = s(2*nb + 1:2*nb + 3) + sum(mv(:, 1:10), dim=2)
       do p = 1, 20
-        s(5:7) = s(5:7) + cross(x(:, p), mv(:, p))
+        s(2*nb + 4:2*nb + 6) = s(2*nb + 4:2*nb + 6) + cross(x(:, p), mv(:, p))
       end do
     end do
     call sum_all(s)
-    bal%kinetic = s(1); bal%p = s(2:4); bal%l = s(5:7)
+    bal%body_kinetic = s(1:nb); bal%body_strain = s(nb + 1:2*nb)
+    bal%kinetic = sum(bal%body_kinetic); bal%strain = sum(bal%body_strain)
+    bal%p = s(2*nb + 1:2*nb + 3); bal%l = s(2*nb + 4:2*nb + 6)
     bal%work = dot_product(fext, st%q - q0)
     bal%total = bal%kinetic + bal%strain - bal%work
   contains
@@ -95,4 +110,48 @@ contains
       b%total/max(abs(b0%total), tiny(1._dp))
     line = trim(buf)
   end function balance_summary
+
+  !> Where the initial energy E0 (b0%total) went by state b: kinetic, strain, minus the work of
+  !> the loads, the extra terms given (each an energy taken out of the bodies), and what is
+  !> left over, E0 - (kinetic + strain - work + extras): the energy removed by the time
+  !> integrator (beta = 1, gamma = 1.5 damps) and by the contact (the releases and the velocity
+  !> correction). It is a remainder, not a measured dissipation: it also holds every error of
+  !> the other terms.
+  function energy_balance(b0, b, extra) result(line)
+    type(balance_t), intent(in) :: b0, b
+    type(energy_term_t), intent(in), optional :: extra(:)
+    character(len=:), allocatable :: line
+    real(dp) :: rest
+    integer :: k
+    rest = b0%total - (b%kinetic + b%strain - b%work)
+    line = 'energy balance: E0 = '//num(b0%total)//' J, kinetic '//num(b%kinetic)//', strain '// &
+           num(b%strain)//', work of loads '//num(b%work)
+    if (present(extra)) then
+      do k = 1, size(extra)
+        line = line//', '//extra(k)%name//' '//num(extra(k)%value)
+        rest = rest - extra(k)%value
+      end do
+    end if
+    line = line//', removed by the time integrator and contact '//num(rest)
+    if (abs(b0%total) > 0) then
+      line = line//' ('//pct(100*rest/abs(b0%total))//'% of E0)'
+    end if
+  contains
+    function num(x) result(str)
+      real(dp), intent(in) :: x
+      character(len=:), allocatable :: str
+      character(len=16) :: w
+      write (w, '(es11.4)') x
+      str = trim(adjustl(w))
+    end function num
+    function pct(x) result(str)
+      real(dp), intent(in) :: x
+      character(len=:), allocatable :: str
+      character(len=24) :: w
+      write (w, '(f0.3)') x
+      str = trim(adjustl(w))
+      if (str(1:1) == '.') str = '0'//str
+      if (str(1:2) == '-.') str = '-0'//str(2:)
+    end function pct
+  end function energy_balance
 end module casca_accounting

@@ -20,7 +20,8 @@ module casca_assembly
   use casca_metis, only: partition_elements
   implicit none
   private
-  public :: assembly_t, block_t, assembly_setup, assemble, strain_energy, nblocks
+  public :: assembly_t, block_t, assembly_setup, assemble, strain_energy, strain_energy_local, &
+            nblocks
 
   integer, parameter :: nblocks = 2   !< 1: this rank's group's bodies; 2: the shared bodies
 
@@ -284,11 +285,23 @@ contains
     end function qs_part
   end subroutine assemble
 
-  !> Strain energy of q (sum over ranks), balanced over the ranks whatever the groups.
-  real(dp) function strain_energy(model, asm, q) result(energy)
+  !> Strain energy of q per body (sum over ranks), balanced over the ranks whatever the groups.
+  function strain_energy(model, asm, q) result(energy)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(in) :: asm
     real(dp), intent(in) :: q(:)
+    real(dp) :: energy(model%nbody)
+    call strain_energy_local(model, asm, q, energy)
+    call sum_all(energy)
+  end function strain_energy
+
+  !> This rank's share of the strain energy of q per body, not summed over the ranks: for a
+  !> caller that sums it with other figures in one reduction (casca_accounting).
+  subroutine strain_energy_local(model, asm, q, energy)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(in) :: asm
+    real(dp), intent(in) :: q(:)
+    real(dp), intent(out) :: energy(:)   !< (nbody)
     real(dp) :: fe(ndof_elem), ke(ndof_elem, ndof_elem), ue   ! ke: not touched
     integer :: i, e, b
     energy = 0
@@ -299,10 +312,9 @@ contains
                               model%body(b)%mu, model%binv(:, :, :, e), model%wdet(:, e), &
                               reshape(q(element_dofs(model, e)), [7, 10]), .false., ue, fe, ke, &
                               want_f=.false.)
-      energy = energy + ue
+      energy(b) = energy(b) + ue
     end do
-    call sum_all(energy)
-  end function strain_energy
+  end subroutine strain_energy_local
 
   !> ke += m (x) I3 on the (Y, G) parameters
   pure subroutine add_mass(ke, m)
