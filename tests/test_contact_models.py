@@ -1,0 +1,147 @@
+"""Contact as engineers model it (issue 16): shell faces, rigid obstacles, deck errors.
+
+usage: test_contact_models.py CASCA MESH_DIR WORK_DIR
+
+Each case is a scene written for this test, not a shipped one. It asserts:
+faces      a strip (h1 10 mm) falls flat at v = 5 m/s onto a fixed plate (h2 20 mm), mid-surfaces
+           d = 50 mm apart (trapezoidal rule, dt 50 us): the first step with contacts ends within
+           one step after (d - (h1 + h2)/2) / v = 7 ms (and none before it).
+equivalent two thesis rings (h 0.05) with contact at the faces and 0.06 m between mid-surfaces
+           against the same rings with contact between mid-surfaces 0.01 m apart (the gap
+           widened by h): the same motion. Contact starts in the same step; the struck ring's
+           kinetic energy and the total strain energy agree at every step within 0.5% of their
+           largest value and the impactor's tracked node within 1e-4 m (the faces' offset moves
+           with the fibre's tilt and the thickness strain, which the mid-surface model lacks).
+floor      a free ring (R 0.2, h 40 mm) at 2 m/s onto a fixed rigid plane (thesis Newmark):
+           the reaction impulse (the sum of the floor's force over the steps, dt F at each step
+           end, the rule Newmark with gamma = 1.5 applies to a force that starts and ends at zero)
+           equals the ring's momentum change to 1e-5 relative (Newton's residual tolerance, 1e-6
+           of the scene's force per step: the faces' offset enters Newton's tangent without its
+           second derivatives; measured 5e-6; between mid-surfaces it is 1e-12); momentum along the plane stays
+           below 1e-9 of the initial; no tensile multiplier, largest active gap 1e-9 m; the ring
+           leaves upwards; the energy never rises (1e-9 relative).
+pusher     the same ring at rest, struck by a plane moving at V = 2 m/s: the mid-surface of the
+           tracked lowest node stays h/2 above the moving plane (within 2e-5 m: the face moves
+           with the thickness strain, below 1e-3 here) and after contact the ring moves at least
+           at V (it cannot be overtaken by the plane that pushes it).
+bad input  unknown obstacle shape, a sphere without radius, contact surface 'top', passes 3:
+           exit 2 naming the file, the group and the field.
+"""
+import os
+import sys
+
+import numpy as np
+
+from casca_testlib import Checks, history, run
+
+casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
+os.makedirs(work, exist_ok=True)
+ck = Checks()
+STEEL = "young = 210e9, poisson = 0.3, density = 7700"
+
+
+def go(name, text):
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text)
+    out = os.path.join(work, name)
+    p = run([casca, "run", deck, "--out", out, "-q"])
+    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
+    return history(out) if p.returncode == 0 else None
+
+
+# --- faces: first contact of a strip falling flat
+strip = os.path.join(work, "strip.msh")
+plate = os.path.join(work, "plate.msh")
+run([casca, "mesh", "strip", "--lx", "0.5", "--ly", "0.1", "--nx", "10", "--ny", "2", "-o", strip])
+run([casca, "mesh", "plate", "--lx", "0.8", "--ly", "0.4", "--nx", "4", "--ny", "2", "-o", plate])
+dt, v, d, h1, h2 = 5e-5, 5.0, 0.05, 0.01, 0.02
+h = go("faces", f"""&run dt = {dt}, t_end = 8.0e-3, beta = 0.25, gamma = 0.5 /
+&output vtu = .false., plots = .false. /
+&body name = 'strip', mesh = 'file', file = '{strip}', center = -0.25, -0.05, {d},
+  velocity = 0.0, 0.0, {-v}, {STEEL}, thickness = {h1} /
+&body name = 'plate', mesh = 'file', file = '{plate}', center = -0.4, -0.2, 0.0,
+  {STEEL}, thickness = {h2} /
+&restraint body = 'plate', fix = 'all' /
+""")
+if h is not None:
+    t_touch = (d - (h1 + h2) / 2) / v
+    first = h["t"][np.nonzero(h["contacts"] > 0)[0][0]]
+    ck.record("faces: first contact within one step after (d - (h1+h2)/2)/v = %.4g s" % t_touch,
+              t_touch <= first + 1e-12 and first <= t_touch + dt + 1e-12, "first step with contacts ends at %.6g s" % first)
+
+# --- faces against mid-surfaces with the gap widened by h
+ring = os.path.join(meshdir, "ring_20x1.msh")
+runs = {}
+for surface, centre in (("faces", 2.06), ("mid", 2.01)):
+    runs[surface] = go("rings_" + surface, f"""&run dt = 5.0e-5, t_end = 3.0e-2 /
+&output vtu = .false., plots = .false., track = 1.0, 0.0, 0.0, track_body = 'ring1' /
+&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0,
+  {STEEL}, thickness = 0.05 /
+&body name = 'ring2', mesh = 'file', file = '{ring}', center = {centre}, 0.0, 0.0,
+  {STEEL}, thickness = 0.05 /
+&contact surface = '{surface}' /
+""")
+a, b = runs["faces"], runs["mid"]
+if a is not None and b is not None:
+    ck.record("equivalent: contact starts in the same step",
+              a["t"][a["contacts"] > 0][0] == b["t"][b["contacts"] > 0][0],
+              "%.6g vs %.6g s" % (a["t"][a["contacts"] > 0][0], b["t"][b["contacts"] > 0][0]))
+    for col in ("kinetic_ring2", "strain"):
+        ck.le("equivalent: %s, largest difference / largest value" % col,
+              np.max(np.abs(a[col] - b[col])) / np.max(np.abs(b[col])), 5e-3)
+    ck.le("equivalent: tracked node of ring1, largest difference [m]", np.max(np.abs(a["p1_x"] - b["p1_x"])), 1e-4)
+
+# --- a rigid floor
+ring2 = os.path.join(work, "ring_r02.msh")
+run([casca, "mesh", "ring", "--radius", "0.2", "--width", "0.05", "--n-around", "20", "--n-across", "1", "-o", ring2])
+hr, dt = 0.04, 2e-5
+h = go("floor", f"""&run dt = {dt}, t_end = 1.2e-2 /
+&output vtu = .false., plots = .false. /
+&body name = 'ring', mesh = 'file', file = '{ring2}', velocity = 0.0, -2.0, 0.0, {STEEL}, thickness = {hr} /
+&obstacle name = 'floor', shape = 'plane', point = 0.0, -0.23, 0.0, normal = 0.0, 1.0, 0.0 /
+""")
+if h is not None:
+    f = h["fcontact_ring_floor"]
+    impulse = np.sum(f[1:] * np.diff(h["t"]))
+    ck.record("floor: contact happens and ends", f.max() > 0 and f[-1] == 0)
+    ck.close("floor: reaction impulse vs momentum change [N s]", impulse, h["py"][-1] - h["py"][0], 1e-5)
+    p0 = abs(h["py"][0])
+    ck.le("floor: momentum along the plane / initial", max(np.abs(h["px"]).max(), np.abs(h["pz"]).max()) / p0, 1e-9)
+    ck.le("floor: most tensile multiplier [N]", h["lambda_max"].max(), 0.0)
+    ck.le("floor: largest active gap [m]", h["gap_max"].max(), 1e-9)
+    ck.record("floor: the ring leaves upwards", h["py"][-1] > 0, "py %.4g" % h["py"][-1])
+    ck.le("floor: largest E/E0 - 1", h["total"].max() / h["total"][0] - 1, 1e-9)
+
+# --- a moving plane
+V = 2.0
+h = go("pusher", f"""&run dt = {dt}, t_end = 1.5e-2 /
+&output vtu = .false., plots = .false., track = 0.0, -0.2, 0.0, track_body = 'ring' /
+&body name = 'ring', mesh = 'file', file = '{ring2}', {STEEL}, thickness = {hr} /
+&obstacle name = 'pusher', shape = 'plane', point = 0.0, -0.221, 0.0, normal = 0.0, 1.0, 0.0,
+  velocity = 0.0, {V}, 0.0 /
+""")
+if h is not None:
+    m = 7700 * hr * 0.05 * 2 * np.pi * 0.2
+    gap = h["p1_y"] - hr / 2 - (-0.221 + V * h["t"])
+    ck.le("pusher: deepest the lowest node's nominal face goes behind the plane [m]", -gap.min(), 2e-5)
+    ck.record("pusher: contact happens", h["contacts"].max() > 0)
+    ck.record("pusher: after contact the ring moves at least at V", h["contacts"][-1] == 0 and h["py"][-1] / m >= V,
+              "vy %.4g m/s" % (h["py"][-1] / m))
+
+# --- bad input
+base = f"""&run dt = 1e-5, t_end = 1e-4 /
+&body name = 'ring', mesh = 'file', file = '{ring2}', {STEEL}, thickness = {hr} /
+"""
+for name, extra, needles in (
+        ("unknown obstacle shape", "&obstacle name = 'w', shape = 'cone' /\n", ["&obstacle", "shape", "cone"]),
+        ("sphere without radius", "&obstacle name = 'w', shape = 'sphere' /\n", ["&obstacle", "radius", "missing"]),
+        ("contact surface 'top'", "&contact surface = 'top' /\n", ["&contact", "surface", "faces"]),
+        ("passes = 3", "&contact passes = 3 /\n", ["&contact", "passes"])):
+    deck = os.path.join(work, "bad.nml")
+    with open(deck, "w") as f:
+        f.write(base + extra)
+    p = run([casca, "check", deck])
+    ck.record("bad input, %s: exit 2 naming the file and field" % name,
+              p.returncode == 2 and "bad.nml" in p.stderr and all(n in p.stderr for n in needles), p.stderr[-300:])
+ck.finish()
