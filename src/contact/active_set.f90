@@ -33,14 +33,15 @@ contains
     allocate (x(3, model%nnode))
     x = positions(model, q)
     c%geo%grid_ok = .false.
-    ! active constraints: project again (the target moves and the node slides)
+    ! active constraints: project again (the target moves and the node slides), or with
+    ! reproject = .false. hold the point
     do k = 1, c%nact
-      if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
-        if (present(reproject)) then
-          if (.not. reproject) then
-            call constraint_geometry(c, model, x, q, c%act(k)); cycle
-          end if
+      if (present(reproject) .and. (c%pair(2, c%act(k)%pair) <= 0 .or. c%act(k)%elem > 0)) then
+        if (.not. reproject) then
+          call constraint_geometry(c, model, x, q, c%act(k)); cycle
         end if
+      end if
+      if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
         call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
         if (found) then
           c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd

@@ -24,9 +24,11 @@ module casca_contact
     real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
     real(dp) :: gap = 0, lambda = 0
     real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)
-    !> the offset's derivatives: d off = dg(1) n.dG_node + dg(2) dA_node
-    !>                                  + sum_j N_j (dg(3) n.dG_j + dg(4) dA_j) (target nodes)
-    real(dp) :: dg(4) = 0
+    !> the gap's derivative on the fibres: wg(1) n.dG at the node, wg(2) sum_j N_j n.dG_j
+    real(dp) :: wg(2) = 0
+    !> which face (+-1 on the fibre; 2: an edge) of the impactor node and of the target is in
+    !> contact, chosen when the constraint is made (0: not yet)
+    integer :: face(2) = 0
     real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected
     real(dp) :: mu = 0          !< the acceleration's correction: M a += C^T mu (after a step)
   end type constraint_t

@@ -16,8 +16,9 @@ module casca_contact_correction
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof
+  use casca_shell_element, only: ndof_node
   use casca_contact, only: contact_t, constraint_t
-  use casca_contact_projection, only: constraint_entries
+  use casca_contact_projection, only: constraint_row, max_row
   use casca_mass_solver, only: mass_solver_t
   use casca_lapack, only: dpotrf, dpotrs
   implicit none
@@ -90,13 +91,10 @@ contains
     real(dp) function row_dot(k, y)
       integer, intent(in) :: k
       real(dp), intent(in) :: y(:)
-      integer :: j, nodes(11), nn
-      real(dp) :: w(11)
-      call constraint_entries(c%act(k), model, nodes, w, nn)
-      row_dot = 0
-      do j = 1, nn
-        row_dot = row_dot + w(j)*dot_product(c%act(k)%n, y(dof(nodes(j), 1):dof(nodes(j), 3)))
-      end do
+      integer :: nd, d(max_row)
+      real(dp) :: w(max_row)
+      call constraint_row(c%act(k), model, d, w, nd)
+      row_dot = dot_product(w(1:nd), y(d(1:nd)))
     end function row_dot
 
     !> normal speed of the obstacle constraint k presses on (0 for a body)
@@ -146,21 +144,22 @@ contains
   end subroutine add_impulses
 
   !> B (equations of component comp of ms, one column per constraint): the rows of C on
-  !> that component, n on the impactor node and -N_j n on the target's nodes
+  !> that component's parameters (the mid-surface point's and the fibre's)
   subroutine constraint_columns(ms, cons, model, comp, b)
     type(mass_solver_t), intent(in) :: ms
     type(constraint_t), intent(in) :: cons(:)
     type(model_t), intent(in) :: model
     integer, intent(in) :: comp
     real(dp), intent(out) :: b(:, :)
-    integer :: col, j, nodes(11), nn, d
-    real(dp) :: w(11)
+    integer :: col, j, nd, d(max_row), e
+    real(dp) :: w(max_row)
     b = 0
     do col = 1, size(cons)
-      call constraint_entries(cons(col), model, nodes, w, nn)
-      do j = 1, nn
-        d = ms%eq(dof(nodes(j), comp))
-        if (d > 0) b(d, col) = b(d, col) + w(j)*cons(col)%n(comp)
+      call constraint_row(cons(col), model, d, w, nd)
+      do j = 1, nd
+        if (mod(mod(d(j) - 1, ndof_node), 3) + 1 /= comp) cycle   ! (Y_comp or G_comp)
+        e = ms%eq(d(j))
+        if (e > 0) b(e, col) = b(e, col) + w(j)
       end do
     end do
   end subroutine constraint_columns

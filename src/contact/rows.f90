@@ -3,13 +3,12 @@
 module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t, constraint_t
-  use casca_contact_projection, only: constraint_entries
+  use casca_contact, only: contact_t
+  use casca_contact_projection, only: constraint_entries, constraint_row, max_row
   implicit none
   private
   public :: contact_rows, contact_generalized_force, contact_force_total, contact_nodal_fields
 
-  integer, parameter :: max_row = 77   !< 11 nodes x (Y, G, A)
 
 contains
 
@@ -52,37 +51,6 @@ contains
     end do
   end subroutine contact_generalized_force
 
-  !> Row of C of one constraint as parameters d(1:nd) and values v(1:nd): the mid-surface
-  !> points along n, and with faces the offset's dependence on the fibres and thicknesses
-  subroutine constraint_row(a, model, d, v, nd)
-    type(constraint_t), intent(in) :: a
-    type(model_t), intent(in) :: model
-    integer, intent(out) :: d(max_row), nd
-    real(dp), intent(out) :: v(max_row)
-    integer :: j, comp, nodes(11), nn
-    real(dp) :: w(11), wf
-    nd = 0
-    call constraint_entries(a, model, nodes, w, nn)
-    do comp = 1, 3
-      do j = 1, nn
-        call put(dof(nodes(j), comp), w(j)*a%n(comp))
-      end do
-    end do
-    if (all(a%dg == 0)) return
-    do j = 1, nn   ! d gap = -d off
-      wf = merge(1._dp, -w(j), j == 1)   ! (N_j at the target's nodes)
-      do comp = 1, 3
-        call put(dof(nodes(j), 3 + comp), -wf*a%dg(merge(1, 3, j == 1))*a%n(comp))
-      end do
-      call put(dof(nodes(j), 7), -wf*a%dg(merge(2, 4, j == 1)))
-    end do
-  contains
-    subroutine put(dd, vv)
-      integer, intent(in) :: dd
-      real(dp), intent(in) :: vv
-      nd = nd + 1; d(nd) = dd; v(nd) = vv
-    end subroutine put
-  end subroutine constraint_row
 
   !> Total normal contact force (sum of the compressive multipliers).
   pure real(dp) function contact_force_total(c)

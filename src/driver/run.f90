@@ -423,7 +423,8 @@ contains
           ' s; results in ', dir
         print '(a)', timer_report(wall_time() - t0)
         if (deck%run%analysis /= 'static' .and. restart_step < 0) then
-          print '(a)', balance_summary(bal0, bal, model%length)
+          print '(a)', balance_summary(bal0, bal, model%length, any(model%fixed) .or. &
+                                       any(fext /= 0) .or. any(fgrav /= 0) .or. size(deck%obstacles) > 0)
           print '(a)', energy_balance(bal0, bal)
         end if
       end if
