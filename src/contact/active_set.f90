@@ -4,8 +4,9 @@ module casca_contact_active_set
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
-  use casca_contact, only: contact_t, constraint_t, search_radius, pair_offset
+  use casca_contact, only: contact_t, constraint_t, search_radius, pair_offset, stick
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry
+  use casca_contact_friction, only: friction_on
   implicit none
   private
   public :: contact_update, contact_release
@@ -36,6 +37,7 @@ contains
     ! active constraints: project again (the target moves and the node slides), or with
     ! reproject = .false. hold the point
     do k = 1, c%nact
+      if (c%act(k)%grip == 0 .and. friction_on(c, c%act(k)%pair)) c%act(k)%grip = stick   ! (restart)
       if (present(reproject) .and. (c%pair(2, c%act(k)%pair) <= 0 .or. c%act(k)%elem > 0)) then
         if (.not. reproject) then
           call constraint_geometry(c, model, x, q, c%act(k)); cycle
@@ -93,9 +95,10 @@ contains
     end do
     if (added > 0) c%changes = c%changes + 1
   contains
-    !> add cn if its gap is beyond the tolerance
+    !> add cn if its gap is beyond the tolerance (sticking, with friction)
     subroutine take(cn)
       type(constraint_t), intent(inout) :: cn
+      if (friction_on(c, cn%pair)) cn%grip = stick
       call constraint_geometry(c, model, x, q, cn)
       if (cn%gap < -c%tol) then
         call push(cn)

@@ -31,7 +31,18 @@ module casca_contact
     integer :: face(2) = 0
     real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected
     real(dp) :: mu = 0          !< the acceleration's correction: M a += C^T mu (after a step)
+    ! Coulomb friction
+    integer :: grip = 0         !< 0 frictionless, stick or slip
+    real(dp) :: t(3, 2) = 0     !< tangents across n (the stick rows' directions)
+    real(dp) :: lt(2) = 0       !< stick multipliers: the force on the node is -lt(1) t1 - lt(2) t2
+    real(dp) :: mut(2) = 0      !< their acceleration correction
+    real(dp) :: gt(2) = 0       !< stick rows' gaps: relative tangential displacement in the step
+    real(dp) :: s(3) = 0        !< slip direction of the node relative to the target, held
+    real(dp) :: ut(3) = 0       !< relative tangential displacement in the step
+    integer :: flips = 0        !< stick/slip changes in this step
   end type constraint_t
+
+  integer, parameter, public :: stick = 1, slip = 2
 
   !> The target bodies' surfaces as the search and the normals need them.
   type :: target_geometry_t
@@ -58,6 +69,13 @@ module casca_contact
                                                 !< or -k for obstacle k
     type(obstacle_t), allocatable :: obstacle(:)
     real(dp) :: time = 0                        !< obstacles are where they are at this time
+    ! Coulomb friction per pair: dynamic and static coefficients; the step's start positions
+    ! and length (friction needs them: without them, as in statics, contact is frictionless)
+    real(dp), allocatable :: mu_d(:), mu_s(:)
+    real(dp), allocatable :: x_start(:, :)
+    real(dp) :: dt = 0
+    real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
+    real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
     type(target_geometry_t) :: geo
     ! the active set
     integer :: nact = 0
@@ -84,7 +102,8 @@ contains
     c%obstacle = obstacles
     c%tol = tol
     c%faces = faces
-    allocate (c%act(16))
+    allocate (c%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
+    c%mu_d = 0; c%mu_s = 0; c%friction_work = 0
     associate (g => c%geo)
       allocate (g%surf(model%nbody), g%grid(c%npairs), g%grid_ok(c%npairs), g%depth(model%nbody), &
                 g%skip(model%nbody))

@@ -19,6 +19,7 @@ module casca_contact_correction
   use casca_shell_element, only: ndof_node
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_projection, only: constraint_row, max_row
+  use casca_contact_rows, only: constraint_kinds
   use casca_mass_solver, only: mass_solver_t
   use casca_lapack, only: dpotrf, dpotrs
   implicit none
@@ -32,8 +33,9 @@ module casca_contact_correction
 contains
 
   !> Project v and a (full-length, every rank alike) onto the active constraints' persistent
-  !> contact: C v+ = 0, C a+ = 0. impulse: the velocity's nu (M (v+ - v) = C^T nu); the
-  !> acceleration's is kept in each constraint (mu).
+  !> contact: C v+ = 0, C a+ = 0 (with friction, the sticking ones' tangential rows too).
+  !> impulse: the velocity's nu (M (v+ - v) = C^T nu); the acceleration's is kept in each
+  !> constraint (mu, mut).
   subroutine contact_correction(ms, c, model, v, a, err, impulse)
     type(mass_solver_t), intent(inout) :: ms
     type(contact_t), intent(inout) :: c
@@ -43,14 +45,15 @@ contains
     real(dp), intent(out), optional :: impulse(:)
     real(dp), allocatable :: s(:, :), nu(:, :), b(:, :), x(:, :)
     type(columns_t) :: held(3)   ! M^-1 C^T by component
-    integer :: nc, k, info, sv, comp, ncomp, j
-    integer, allocatable :: comps(:)
-    nc = c%nact
-    if (nc == 0) return
+    integer :: nc, r, info, sv, comp, ncomp, j
+    integer, allocatable :: comps(:), rk(:), rkind(:)
+    if (c%nact == 0) return
+    call row_list(c%act(1:c%nact), rk, rkind)
+    nc = size(rk)
     allocate (s(nc, nc), nu(nc, 2))
-    ! (against a moving obstacle the node keeps the obstacle's normal speed)
-    nu(:, 1) = -[(row_dot(k, v) - obstacle_rate(k), k=1, nc)]
-    nu(:, 2) = -[(row_dot(k, a), k=1, nc)]
+    ! (against a moving obstacle the node keeps the obstacle's speed)
+    nu(:, 1) = -[(row_dot(r, v) - obstacle_rate(r), r=1, nc)]
+    nu(:, 2) = -[(row_dot(r, a), r=1, nc)]
     ! S = sum over components of B^T M^-1 B (B: the component's part of C^T, as columns);
     ! X = M^-1 B is kept: the corrections are X nu. One MUMPS call per distinct matrix.
     s = 0
@@ -60,7 +63,7 @@ contains
       if (ncomp == 0) cycle
       allocate (b(ms%neq(sv), ncomp*nc), x(ms%neq(sv), ncomp*nc))
       do j = 1, ncomp
-        call constraint_columns(ms, c%act(1:nc), model, comps(j), b(:, (j - 1)*nc + 1:j*nc))
+        call constraint_columns(ms, c%act(1:c%nact), rk, rkind, model, comps(j), b(:, (j - 1)*nc + 1:j*nc))
       end do
       call ms%solve_sparse(sv, b, x, err)
       if (allocated(err)) return
@@ -78,7 +81,13 @@ contains
     end if
     call dpotrs('L', nc, 2, s, nc, nu, nc, info)
     if (present(impulse)) impulse = nu(:, 1)
-    c%act(1:nc)%mu = nu(:, 2)
+    do r = 1, nc
+      if (rkind(r) == 0) then
+        c%act(rk(r))%mu = nu(r, 2)
+      else
+        c%act(rk(r))%mut(rkind(r)) = nu(r, 2)
+      end if
+    end do
     do comp = 1, 3   ! v += M^-1 C^T nu_v, a += M^-1 C^T nu_a
       if (ms%neq(comp) == 0) cycle
       associate (xc => held(comp)%x, d => ms%dofs(1:ms%neq(comp), comp))
@@ -87,48 +96,75 @@ contains
       end associate
     end do
   contains
-    !> row k of C times y: the normal relative rate of constraint k
-    real(dp) function row_dot(k, y)
-      integer, intent(in) :: k
+    !> row r of C times y: a relative rate
+    real(dp) function row_dot(r, y)
+      integer, intent(in) :: r
       real(dp), intent(in) :: y(:)
       integer :: nd, d(max_row)
       real(dp) :: w(max_row)
-      call constraint_row(c%act(k), model, d, w, nd)
+      call constraint_row(c%act(rk(r)), model, d, w, nd, rkind(r))
       row_dot = dot_product(w(1:nd), y(d(1:nd)))
     end function row_dot
 
-    !> normal speed of the obstacle constraint k presses on (0 for a body)
-    real(dp) function obstacle_rate(k)
-      integer, intent(in) :: k
+    !> the obstacle's speed along row r (0 for a body)
+    real(dp) function obstacle_rate(r)
+      integer, intent(in) :: r
       integer :: t
-      t = c%pair(2, c%act(k)%pair)
+      t = c%pair(2, c%act(rk(r))%pair)
       obstacle_rate = 0
-      if (t <= 0) obstacle_rate = dot_product(c%act(k)%n, c%obstacle(-t)%velocity)
+      if (t > 0) return
+      associate (con => c%act(rk(r)))
+        if (rkind(r) == 0) then
+          obstacle_rate = dot_product(con%n, c%obstacle(-t)%velocity)
+        else
+          obstacle_rate = dot_product(con%t(:, rkind(r)), c%obstacle(-t)%velocity)
+        end if
+      end associate
     end function obstacle_rate
-
   end subroutine contact_correction
 
+  !> The rows of the constraints cons: constraint rk(r) and kind rkind(r) of row r
+  subroutine row_list(cons, rk, rkind)
+    type(constraint_t), intent(in) :: cons(:)
+    integer, allocatable, intent(out) :: rk(:), rkind(:)
+    integer :: k
+    integer, allocatable :: kinds(:)
+    allocate (rk(0), rkind(0))
+    do k = 1, size(cons)
+      kinds = constraint_kinds(cons(k))
+      rk = [rk, spread(k, 1, size(kinds))]
+      rkind = [rkind, kinds]
+    end do
+  end subroutine row_list
 
-  !> y = y + M^-1 sum_k amount_k C_k^T over the constraints cons (one MUMPS call per
-  !> distinct matrix): the response of the free bodies to equal and opposite impulses
-  subroutine add_impulses(ms, cons, amount, model, y, err)
+  !> y = y + M^-1 C^T (lambda - mu) over the constraints cons, every row (one MUMPS call per
+  !> distinct matrix): takes the forces they carried out of an acceleration
+  subroutine add_impulses(ms, cons, model, y, err)
     type(mass_solver_t), intent(inout) :: ms
     type(constraint_t), intent(in) :: cons(:)
-    real(dp), intent(in) :: amount(:)
     type(model_t), intent(in) :: model
     real(dp), intent(inout) :: y(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), allocatable :: b(:, :), x(:, :), bk(:, :)
-    integer, allocatable :: comps(:)
-    integer :: sv, j
+    real(dp), allocatable :: b(:, :), x(:, :), bk(:, :), amount(:)
+    integer, allocatable :: comps(:), rk(:), rkind(:)
+    integer :: sv, j, r
     if (size(cons) == 0) return
+    call row_list(cons, rk, rkind)
+    allocate (amount(size(rk)))
+    do r = 1, size(rk)
+      if (rkind(r) == 0) then
+        amount(r) = cons(rk(r))%lambda - cons(rk(r))%mu
+      else
+        amount(r) = cons(rk(r))%lt(rkind(r)) - cons(rk(r))%mut(rkind(r))
+      end if
+    end do
     do sv = 1, 3
       comps = pack([1, 2, 3], ms%solver_of == sv .and. ms%neq > 0)
       if (size(comps) == 0) cycle
       allocate (b(ms%neq(sv), size(comps)), x(ms%neq(sv), size(comps)))
-      allocate (bk(ms%neq(sv), size(cons)))
+      allocate (bk(ms%neq(sv), size(rk)))
       do j = 1, size(comps)
-        call constraint_columns(ms, cons, model, comps(j), bk)
+        call constraint_columns(ms, cons, rk, rkind, model, comps(j), bk)
         b(:, j) = matmul(bk, amount)
       end do
       deallocate (bk)
@@ -143,19 +179,20 @@ contains
     end do
   end subroutine add_impulses
 
-  !> B (equations of component comp of ms, one column per constraint): the rows of C on
+  !> B (equations of component comp of ms, one column per row (rk, rkind)): the rows of C on
   !> that component's parameters (the mid-surface point's and the fibre's)
-  subroutine constraint_columns(ms, cons, model, comp, b)
+  subroutine constraint_columns(ms, cons, rk, rkind, model, comp, b)
     type(mass_solver_t), intent(in) :: ms
     type(constraint_t), intent(in) :: cons(:)
+    integer, intent(in) :: rk(:), rkind(:)
     type(model_t), intent(in) :: model
     integer, intent(in) :: comp
     real(dp), intent(out) :: b(:, :)
     integer :: col, j, nd, d(max_row), e
     real(dp) :: w(max_row)
     b = 0
-    do col = 1, size(cons)
-      call constraint_row(cons(col), model, d, w, nd)
+    do col = 1, size(rk)
+      call constraint_row(cons(rk(col)), model, d, w, nd, rkind(col))
       do j = 1, nd
         if (mod(mod(d(j) - 1, ndof_node), 3) + 1 /= comp) cycle   ! (Y_comp or G_comp)
         e = ms%eq(d(j))

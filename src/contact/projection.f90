@@ -7,7 +7,11 @@
 !> constraint's row holds the offset's derivative on G, so the contact force acts at the face
 !> and does work through the fibre's turn. (Held in the linearisation instead, the offset's
 !> change from step to step did work no force paid for: a ring bouncing on a floor with the
-!> trapezoidal rule ended with 5600 times its energy.) The offset is measured at the node and at the target point
+!> trapezoidal rule ended with 5600 times its energy.)
+!>
+!> With Coulomb friction a sticking constraint has two more rows, the relative tangential
+!> displacement of the node over the step (along t1, t2 across n), and a sliding one carries
+!> a known force mu_d |lambda| against its slip direction s, held through the step.
 
 module casca_contact_projection
   use casca_kinds, only: dp
@@ -103,6 +107,7 @@ contains
       if (c%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
                              -con%n, con%face(1), con%off, con%wg(1))
       con%gap = gm - con%off
+      call friction_geometry()
       return
     end if
     call tri10_shape(con%xi(1), con%xi(2), con%shp, dphi)
@@ -148,6 +153,32 @@ contains
       con%wg(2) = -con%wg(2)
     end if
     con%gap = con%side*gm - con%off
+    call friction_geometry()
+  contains
+    !> tangents (the first kept from the last, turned across n) and the relative tangential
+    !> displacement of the node over the step
+    subroutine friction_geometry()
+      real(dp) :: u(3), t1(3)
+      integer :: jj
+      if (con%grip == 0) return
+      t1 = con%t(:, 1) - dot_product(con%t(:, 1), con%n)*con%n
+      if (norm2(t1) < 0.5_dp) then   ! (a new constraint: any direction across n)
+        t1 = [con%n(2), -con%n(1), 0._dp]
+        if (norm2(t1) < 0.5_dp) t1 = [0._dp, con%n(3), -con%n(2)]
+      end if
+      con%t(:, 1) = t1/norm2(t1)
+      con%t(:, 2) = cross(con%n, con%t(:, 1))
+      u = x(:, con%node) - c%x_start(:, con%node)
+      if (con%elem > 0) then
+        do jj = 1, 10
+          u = u - con%shp(jj)*(x(:, model%conn(jj, con%elem)) - c%x_start(:, model%conn(jj, con%elem)))
+        end do
+      else
+        u = u - c%dt*c%obstacle(-bt)%velocity
+      end if
+      con%ut = u - dot_product(u, con%n)*con%n
+      con%gt = [dot_product(u, con%t(:, 1)), dot_product(u, con%t(:, 2))]
+    end subroutine friction_geometry
   end subroutine constraint_geometry
 
   !> Distance f along u of face s of a shell, (h/2) s G.u (along the current fibre, at the
@@ -190,23 +221,33 @@ contains
     m = 11
   end subroutine constraint_entries
 
-  !> Row of C of one constraint as parameters d(1:nd) and values v(1:nd): the mid-surface
-  !> points along n and, between faces, the fibres that carry the offset
-  pure subroutine constraint_row(a, model, d, v, nd)
+  !> Row of C of one constraint as parameters d(1:nd) and values v(1:nd). kind 0: the
+  !> normal row, the mid-surface points along n and, between faces, the fibres that carry the
+  !> offset; kind 1, 2: the stick rows along t1, t2; kind 3: along the slip direction s (the
+  !> sliding force's, mu_d |lambda| on it)
+  pure subroutine constraint_row(a, model, d, v, nd, kind)
     type(constraint_t), intent(in) :: a
     type(model_t), intent(in) :: model
     integer, intent(out) :: d(max_row), nd
     real(dp), intent(out) :: v(max_row)
-    integer :: j, comp, nodes(11), nn
-    real(dp) :: w(11), wf
+    integer, intent(in), optional :: kind
+    integer :: j, comp, nodes(11), nn, kd
+    real(dp) :: w(11), wf, dir(3)
+    kd = 0
+    if (present(kind)) kd = kind
+    select case (kd)
+    case (0); dir = a%n
+    case (1, 2); dir = a%t(:, kd)
+    case default; dir = a%s
+    end select
     nd = 0
     call constraint_entries(a, model, nodes, w, nn)
     do comp = 1, 3
       do j = 1, nn
-        nd = nd + 1; d(nd) = dof(nodes(j), comp); v(nd) = w(j)*a%n(comp)
+        nd = nd + 1; d(nd) = dof(nodes(j), comp); v(nd) = w(j)*dir(comp)
       end do
     end do
-    if (all(a%wg == 0)) return
+    if (kd /= 0 .or. all(a%wg == 0)) return
     do j = 1, nn
       wf = merge(a%wg(1), -w(j)*a%wg(2), j == 1)   ! (-w(j) = N_j on the target)
       if (wf == 0) cycle

@@ -1,43 +1,114 @@
-!> The active constraints as the equations see them: the rows of C for the saddle point, and
-!> the contact forces C^T lambda they carry.
+!> The active constraints as the equations see them: the rows of C for the saddle point (one
+!> per constraint, two more for a sticking one), their multipliers, and the contact forces
+!> C^T lambda they carry (with the sliding ones' friction).
 module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t
+  use casca_contact, only: contact_t, constraint_t, stick, slip
   use casca_contact_projection, only: constraint_entries, constraint_row, max_row
   implicit none
   private
-  public :: contact_rows, contact_generalized_force, contact_force_total, contact_nodal_fields
-
+  public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
+  public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
+  public :: constraint_kinds, slip_force, obstacle_power
 
 contains
 
-  !> Constraint rows for MUMPS: entries (neq + k, eq) of dg_k/dq (irn > jcn), a zero
-  !> diagonal for each multiplier, and the gaps.
-  subroutine contact_rows(c, model, eq, neq, irn, jcn, val, gap)
+  !> The row kinds of a constraint: 0 (normal), and 1, 2 (stick) when it sticks
+  pure function constraint_kinds(a) result(kinds)
+    type(constraint_t), intent(in) :: a
+    integer, allocatable :: kinds(:)
+    if (a%grip == stick) then
+      kinds = [0, 1, 2]
+    else
+      kinds = [0]
+    end if
+  end function constraint_kinds
+
+  !> Number of rows of the active set
+  pure integer function contact_nrows(c)
+    type(contact_t), intent(in) :: c
+    contact_nrows = c%nact + 2*count(c%act(1:c%nact)%grip == stick)
+  end function contact_nrows
+
+  !> The multipliers of every row, in row order
+  pure function contact_multipliers(c) result(lam)
+    type(contact_t), intent(in) :: c
+    real(dp), allocatable :: lam(:)
+    integer :: k
+    allocate (lam(0))
+    do k = 1, c%nact
+      lam = [lam, c%act(k)%lambda]
+      if (c%act(k)%grip == stick) lam = [lam, c%act(k)%lt]
+    end do
+  end function contact_multipliers
+
+  pure subroutine contact_set_multipliers(c, lam)
+    type(contact_t), intent(inout) :: c
+    real(dp), intent(in) :: lam(:)
+    integer :: k, r
+    r = 0
+    do k = 1, c%nact
+      r = r + 1; c%act(k)%lambda = lam(r)
+      if (c%act(k)%grip /= stick) cycle
+      c%act(k)%lt = lam(r + 1:r + 2); r = r + 2
+    end do
+  end subroutine contact_set_multipliers
+
+  !> Constraint rows for MUMPS: entries (neq + r, eq) of dg_r/dq (irn > jcn), a zero
+  !> diagonal for each multiplier, the gaps, and each row's key (node and kind, element).
+  !> fval: the same entries of the columns the multipliers act through: C^T, but for a
+  !> sliding constraint's normal row n - mu_d s on its points (its friction follows |lambda|).
+  subroutine contact_rows(c, model, eq, neq, irn, jcn, val, gap, key, fval)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     integer, intent(in) :: eq(:), neq
-    integer, allocatable, intent(out) :: irn(:), jcn(:)
-    real(dp), allocatable, intent(out) :: val(:), gap(:)
-    integer :: k, j, m, nd, d(max_row)
-    real(dp) :: v(max_row)
-    allocate (irn((max_row + 1)*c%nact), jcn((max_row + 1)*c%nact), val((max_row + 1)*c%nact), &
-              gap(c%nact))
-    m = 0
+    integer, allocatable, intent(out) :: irn(:), jcn(:), key(:, :)
+    real(dp), allocatable, intent(out) :: val(:), gap(:), fval(:)
+    integer :: k, j, m, nd, d(max_row), r, i, nr, ns
+    integer, allocatable :: kinds(:)
+    real(dp) :: v(max_row), vs(max_row), mu
+    nr = contact_nrows(c)
+    allocate (irn((max_row + 1)*nr), jcn((max_row + 1)*nr), val((max_row + 1)*nr), gap(nr), key(2, nr), &
+              fval((max_row + 1)*nr))
+    m = 0; r = 0
     do k = 1, c%nact
-      gap(k) = c%act(k)%gap
-      call constraint_row(c%act(k), model, d, v, nd)
-      do j = 1, nd
-        if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
-        m = m + 1; irn(m) = neq + k; jcn(m) = eq(d(j)); val(m) = v(j)
+      kinds = constraint_kinds(c%act(k))
+      do i = 1, size(kinds)
+        r = r + 1
+        if (kinds(i) == 0) then
+          gap(r) = c%act(k)%gap
+        else
+          gap(r) = c%act(k)%gt(kinds(i))
+        end if
+        key(:, r) = [4*c%act(k)%node + kinds(i), c%act(k)%elem]
+        call constraint_row(c%act(k), model, d, v, nd, kinds(i))
+        mu = 0; ns = 0
+        if (kinds(i) == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
+          mu = c%mu_d(c%act(k)%pair); key(1, r) = 4*c%act(k)%node + 3
+          call constraint_row(c%act(k), model, d, vs, ns, 3)   ! (the same points first)
+        end if
+        do j = 1, nd
+          if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
+          m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = v(j); fval(m) = v(j)
+          if (j <= ns) fval(m) = v(j) - mu*vs(j)
+        end do
+        m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
       end do
-      m = m + 1; irn(m) = neq + k; jcn(m) = neq + k; val(m) = 0
     end do
-    irn = irn(1:m); jcn = jcn(1:m); val = val(1:m)
+    irn = irn(1:m); jcn = jcn(1:m); val = val(1:m); fval = fval(1:m)
   end subroutine contact_rows
 
-  !> f = C^T lambda (ndof): the multipliers' generalized force, fibres and thicknesses included
+  !> The sliding force's multiplier on the row along s: mu_d |lambda| (0 unless sliding)
+  pure real(dp) function slip_force(c, a)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    slip_force = 0
+    if (a%grip == slip) slip_force = c%mu_d(a%pair)*max(-a%lambda, 0._dp)
+  end function slip_force
+
+  !> f = C^T lambda (ndof) with the sliding friction: minus the contact forces, on the fibres
+  !> too between faces
   subroutine contact_generalized_force(c, model, f)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
@@ -46,11 +117,21 @@ contains
     real(dp) :: v(max_row)
     f = 0
     do k = 1, c%nact
-      call constraint_row(c%act(k), model, d, v, nd)
-      f(d(1:nd)) = f(d(1:nd)) + c%act(k)%lambda*v(1:nd)
+      associate (a => c%act(k))
+        call constraint_row(a, model, d, v, nd)
+        f(d(1:nd)) = f(d(1:nd)) + a%lambda*v(1:nd)
+        if (a%grip == stick) then
+          call constraint_row(a, model, d, v, nd, 1)
+          f(d(1:nd)) = f(d(1:nd)) + a%lt(1)*v(1:nd)
+          call constraint_row(a, model, d, v, nd, 2)
+          f(d(1:nd)) = f(d(1:nd)) + a%lt(2)*v(1:nd)
+        else if (a%grip == slip) then
+          call constraint_row(a, model, d, v, nd, 3)
+          f(d(1:nd)) = f(d(1:nd)) + slip_force(c, a)*v(1:nd)
+        end if
+      end associate
     end do
   end subroutine contact_generalized_force
-
 
   !> Total normal contact force (sum of the compressive multipliers).
   pure real(dp) function contact_force_total(c)
@@ -58,19 +139,55 @@ contains
     contact_force_total = -sum(c%act(1:c%nact)%lambda)
   end function contact_force_total
 
-  !> Nodal contact force (3, nnode) on the bodies (both sides of a pair), -C^T lambda.
+  !> Largest |gap| of the active rows (normal, and stick rows' tangential displacement)
+  pure real(dp) function contact_max_gap(c)
+    type(contact_t), intent(in) :: c
+    integer :: k
+    contact_max_gap = 0
+    do k = 1, c%nact
+      contact_max_gap = max(contact_max_gap, abs(c%act(k)%gap))
+      if (c%act(k)%grip == stick) contact_max_gap = max(contact_max_gap, maxval(abs(c%act(k)%gt)))
+    end do
+  end function contact_max_gap
+
+  !> Power of the obstacles' forces on the bodies (moving obstacles do work)
+  pure real(dp) function obstacle_power(c)
+    type(contact_t), intent(in) :: c
+    integer :: k, t
+    obstacle_power = 0
+    do k = 1, c%nact
+      t = c%pair(2, c%act(k)%pair)
+      if (t > 0) cycle
+      obstacle_power = obstacle_power + dot_product(node_force(c, c%act(k)), c%obstacle(-t)%velocity)
+    end do
+  end function obstacle_power
+
+  !> The contact force on the constraint's node: normal and friction
+  pure function node_force(c, a) result(f)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    real(dp) :: f(3)
+    f = -a%lambda*a%n
+    if (a%grip == stick) f = f - a%lt(1)*a%t(:, 1) - a%lt(2)*a%t(:, 2)
+    if (a%grip == slip) f = f - slip_force(c, a)*a%s
+  end function node_force
+
+  !> Nodal contact force (3, nnode) on the bodies (both sides of a pair): normal and friction
   pure subroutine contact_nodal_fields(c, model, force)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(out) :: force(:, :)
     integer :: k, j, nodes(11), nn
-    real(dp) :: w(11)
+    real(dp) :: w(11), f(3)
     force = 0
     do k = 1, c%nact
-      call constraint_entries(c%act(k), model, nodes, w, nn)
-      do j = 1, nn
-        force(:, nodes(j)) = force(:, nodes(j)) - c%act(k)%lambda*w(j)*c%act(k)%n
-      end do
+      associate (a => c%act(k))
+        f = node_force(c, a)
+        call constraint_entries(a, model, nodes, w, nn)
+        do j = 1, nn
+          force(:, nodes(j)) = force(:, nodes(j)) + w(j)*f
+        end do
+      end associate
     end do
   end subroutine contact_nodal_fields
 end module casca_contact_rows

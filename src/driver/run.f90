@@ -12,7 +12,8 @@ module casca_run
   use casca_mass_solver, only: mass_setup
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
-  use casca_accounting, only: balance_t, account, gravity_load, balance_summary, energy_balance
+  use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
+                              energy_balance
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
                           output_flush, output_release
   use casca_vtu_writer, only: field_t, field
@@ -21,6 +22,7 @@ module casca_run
   use casca_contact_rows, only: contact_force_total, contact_nodal_fields
   use casca_contact_probes, only: contact_penetration, contact_signed_distance
   use casca_pair_report, only: pair_normal_force, pair_active_count, pair_labels
+  use casca_contact_friction, only: pair_tangential_force
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
   use casca_free_flight, only: idle_bodies, advance_idle
@@ -165,7 +167,11 @@ contains
     block   ! the history's per-body and per-pair columns are named after these
       character(len=64), allocatable :: body_names(:)   ! (the deck's longest name)
       character(len=:), allocatable :: pair_names(:)
+      logical :: friction
       body_names = [character(len=64) :: (model%body(k)%name, k=1, model%nbody)]
+      friction = .false.
+      if (use_contact) friction = deck%run%analysis /= 'static' .and. (any(contact%mu_d > 0) .or. &
+                                                                      any(contact%mu_s > 0))
       if (use_contact) then
         ! targets -k are obstacles: names from -size(obstacles) up, then the bodies
         call pair_labels(contact%pair, [character(len=64) :: (deck%obstacles(-k)%name, &
@@ -173,7 +179,7 @@ contains
       else
         allocate (character(len=1) :: pair_names(0))
       end if
-      call output_open(out, dir, tracked, labels, body_names, pair_names, restart_step, st%t, err)
+      call output_open(out, dir, tracked, labels, body_names, pair_names, friction, restart_step, st%t, err)
     end block
     if (failed('output')) return
 
@@ -317,8 +323,37 @@ contains
                           deck%contact%surface == 'faces', contact)
         if (deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
         contact%nodal_normal = deck%contact%normal == 'nodal'
+        call set_friction()
       end if
     end subroutine setup_contact
+
+    !> the energy balance's terms that the scene has: friction's, moving obstacles'
+    function extra_terms() result(terms)
+      type(energy_term_t), allocatable :: terms(:)
+      integer :: k
+      allocate (terms(0))
+      if (.not. use_contact) return
+      if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
+                                                               sum(contact%friction_work))]
+      if (any([(any(deck%obstacles(k)%velocity /= 0), k=1, size(deck%obstacles))])) &
+        terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
+    end function extra_terms
+
+    !> each pair's coefficients: its obstacle's, else &contact's; static defaults to dynamic
+    subroutine set_friction()
+      integer :: p, t
+      real(dp) :: d, st_
+      do p = 1, contact%npairs
+        d = deck%contact%friction; st_ = deck%contact%static_friction
+        t = contact%pair(2, p)
+        if (t < 0) then
+          if (deck%obstacles(-t)%friction /= unset) d = deck%obstacles(-t)%friction
+          if (deck%obstacles(-t)%static_friction /= unset) st_ = deck%obstacles(-t)%static_friction
+        end if
+        contact%mu_d(p) = d
+        contact%mu_s(p) = merge(st_, d, st_ /= unset)
+      end do
+    end subroutine set_friction
 
     subroutine history_row(newton)
       integer, intent(in) :: newton
@@ -329,7 +364,8 @@ contains
         if (contact%nact > 0) lmax = maxval(contact%act(1:contact%nact)%lambda)
         call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
                             max(pen, 0._dp), rep%neg_pivots, lmax, gmax, &
-                            pair_normal_force(contact), pair_active_count(contact), err)
+                            pair_normal_force(contact), pair_active_count(contact), err, &
+                            pair_tangential_force(contact), sum(contact%friction_work))
       else
         call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, 0._dp, 0._dp, &
                             [real(dp) ::], [integer ::], err)
@@ -425,7 +461,7 @@ contains
         if (deck%run%analysis /= 'static' .and. restart_step < 0) then
           print '(a)', balance_summary(bal0, bal, model%length, any(model%fixed) .or. &
                                        any(fext /= 0) .or. any(fgrav /= 0) .or. size(deck%obstacles) > 0)
-          print '(a)', energy_balance(bal0, bal)
+          print '(a)', energy_balance(bal0, bal, extra_terms())
         end if
       end if
     end subroutine finish

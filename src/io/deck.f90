@@ -97,6 +97,8 @@ module casca_deck
     character(len=16) :: normal = 'nodal'       !< 'nodal' or 'element' (docs/method.md)
     character(len=16) :: surface = 'faces'      !< 'faces' (thickness offset) or 'mid'
     integer :: passes = 1                       !< 2: each body of a pair impacts the other too
+    real(dp) :: friction = 0                    !< Coulomb: dynamic coefficient
+    real(dp) :: static_friction = unset         !< static coefficient (default: friction)
     integer :: line = 0
   end type contact_cfg_t
 
@@ -109,6 +111,7 @@ module casca_deck
     real(dp) :: radius = unset
     logical :: inside = .false.                 !< sphere, cylinder: the bodies are inside
     real(dp) :: velocity(3) = 0
+    real(dp) :: friction = unset, static_friction = unset   !< (default: &contact's)
     integer :: nbodies = 0                      !< 0: every body
     character(len=64) :: bodies(max_pairs) = ''
     integer :: line = 0
@@ -332,9 +335,10 @@ contains
       type(deck_t), intent(inout) :: dk
       character(len=long) :: name, shape
       character(len=256) :: bodies(max_pairs)
-      real(dp) :: point(3), normal(3), axis(3), radius, velocity(3)
+      real(dp) :: point(3), normal(3), axis(3), radius, velocity(3), friction, static_friction
       logical :: inside
-      namelist /obstacle/ name, shape, point, normal, axis, radius, inside, velocity, bodies
+      namelist /obstacle/ name, shape, point, normal, axis, radius, inside, velocity, bodies, &
+        friction, static_friction
       type(obstacle_cfg_t) :: o
       integer :: io, k
       rewind (uu)
@@ -342,6 +346,7 @@ contains
         o = obstacle_cfg_t()
         name = o%name; shape = o%shape; point = o%point; normal = o%normal; axis = o%axis
         radius = o%radius; inside = o%inside; velocity = o%velocity; bodies = ''
+        friction = o%friction; static_friction = o%static_friction
         read (uu, nml=obstacle, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('obstacle', io), '&obstacle: '//trim(msg))
@@ -352,6 +357,7 @@ contains
         call take(dk, o%line, '&obstacle: shape', lower(shape), o%shape)
         o%point = point; o%normal = normal; o%axis = axis; o%radius = radius
         o%inside = inside; o%velocity = velocity
+        o%friction = friction; o%static_friction = static_friction
         do k = 1, max_pairs
           if (bodies(k) == '') exit
           o%nbodies = k
@@ -491,13 +497,14 @@ contains
     logical :: enabled
     character(len=long) :: solver, normal, surface
     character(len=256) :: pairs(2, max_pairs)   ! (longer than a name: enough to see one too long)
-    real(dp) :: tolerance
+    real(dp) :: tolerance, friction, static_friction
     character(len=256) :: msg
     integer :: ios, k, passes
-    namelist /contact/ enabled, pairs, tolerance, solver, normal, surface, passes
+    namelist /contact/ enabled, pairs, tolerance, solver, normal, surface, passes, friction, &
+      static_friction
     associate (c => deck%contact)
       enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver; normal = c%normal
-      surface = c%surface; passes = c%passes
+      surface = c%surface; passes = c%passes; friction = c%friction; static_friction = c%static_friction
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -509,7 +516,7 @@ contains
       call take(deck, line, '&contact: solver', lower(solver), c%solver)
       call take(deck, line, '&contact: normal', lower(normal), c%normal)
       call take(deck, line, '&contact: surface', lower(surface), c%surface)
-      c%passes = passes
+      c%passes = passes; c%friction = friction; c%static_friction = static_friction
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit

@@ -49,14 +49,14 @@ contains
     case ('contact')
       select case (key)
       case ('pairs', 'solver', 'normal', 'surface'); t = 's'
-      case ('tolerance'); t = 'r'
+      case ('tolerance', 'friction', 'static_friction'); t = 'r'
       case ('passes'); t = 'i'
       case ('enabled'); t = 'l'
       end select
     case ('obstacle')
       select case (key)
       case ('name', 'shape', 'bodies'); t = 's'
-      case ('point', 'normal', 'axis', 'radius', 'velocity'); t = 'r'
+      case ('point', 'normal', 'axis', 'radius', 'velocity', 'friction', 'static_friction'); t = 'r'
       case ('inside'); t = 'l'
       end select
     end select

@@ -188,6 +188,7 @@ contains
       call add_problem(deck, deck%contact%line, '&contact: surface must be ''faces'' or ''mid''')
     if (deck%contact%passes /= 1 .and. deck%contact%passes /= 2) &
       call add_problem(deck, deck%contact%line, '&contact: passes must be 1 or 2')
+    call check_friction(deck%contact%line, '&contact', deck%contact%friction, deck%contact%static_friction)
     do i = 1, size(deck%obstacles)
       call check_obstacle(deck%obstacles(i))
     end do
@@ -212,11 +213,30 @@ contains
         call add_problem(deck, o%line, '&obstacle: shape = '''//trim(o%shape)// &
                          ''' (use plane, sphere or cylinder)')
       end select
+      if (o%friction /= unset .or. o%static_friction /= unset) call check_friction(o%line, &
+        '&obstacle', merge(o%friction, deck%contact%friction, o%friction /= unset), o%static_friction)
       do k = 1, o%nbodies
         if (find_body(o%bodies(k)) == 0) call add_problem(deck, o%line, '&obstacle: bodies names '''// &
           trim(o%bodies(k))//''', which is not a body of the deck')
       end do
     end subroutine check_obstacle
+
+    !> coefficients of friction: >= 0, below 10, the static one (when given) not below the
+    !> dynamic one
+    subroutine check_friction(line, group, dyn, sta)
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: group
+      real(dp), intent(in) :: dyn, sta
+      if (.not. (dyn >= 0 .and. dyn < 10)) call add_problem(deck, line, group// &
+        ': friction must be in [0, 10) (got '//num(dyn)//')')
+      if (sta == unset) return
+      if (.not. (sta >= 0 .and. sta < 10)) then
+        call add_problem(deck, line, group//': static_friction must be in [0, 10) (got '//num(sta)//')')
+      else if (sta < dyn) then
+        call add_problem(deck, line, group//': static_friction ('//num(sta)// &
+                         ') must not be below friction ('//num(dyn)//')')
+      end if
+    end subroutine check_friction
 
     subroutine unit_vector(line, field, v)
       integer, intent(in) :: line

@@ -108,10 +108,10 @@ contains
     real(dp) :: pref, lref
     pref = max(norm2(b0%p), tiny(1._dp))
     lref = max(norm2(b0%l), pref*length)
-    if (external) then
-      write (buf, '(a,es8.1,a,es8.1,a,f8.5)') 'changed by supports, loads or obstacles: linear '// &
-        'momentum by ', norm2(b%p - b0%p)/pref, ', angular momentum by ', norm2(b%l - b0%l)/lref, &
-        '; energy E/E0 = ', b%total/max(abs(b0%total), tiny(1._dp))
+    if (external) then   ! (absolute: the bodies may start at rest)
+      write (buf, '(a,es9.2,a,es9.2,a,es11.4,a)') 'changed by supports, loads or obstacles: linear '// &
+        'momentum by ', norm2(b%p - b0%p), ' N s, angular momentum by ', norm2(b%l - b0%l), &
+        ' N m s; energy by ', b%total - b0%total, ' J'
     else
       write (buf, '(a,es8.1,a,es8.1,a,f8.5)') 'kept: linear momentum to ', norm2(b%p - b0%p)/pref, &
         ', angular momentum to ', norm2(b%l - b0%l)/lref, '; energy E/E0 = ', &
@@ -142,7 +142,7 @@ contains
       end do
     end if
     line = line//', removed by the time integrator and contact '//num(rest)
-    if (abs(b0%total) > 0) then
+    if (abs(rest) < 1e6_dp*abs(b0%total)) then   ! (not of an E0 that is zero or nearly)
       line = line//' ('//pct(100*rest/abs(b0%total))//'% of E0)'
     end if
   contains

@@ -3,7 +3,7 @@ module casca_lapack
   use casca_kinds, only: dp
   implicit none
   private
-  public :: dsyev, dpotrf, dpotrs
+  public :: dsyev, dpotrf, dpotrs, dgetrf, dgetrs
 
   interface
     subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
@@ -29,5 +29,19 @@ module casca_lapack
       real(dp), intent(inout) :: b(ldb, *)
       integer, intent(out) :: info
     end subroutine dpotrs
+    subroutine dgetrf(m, n, a, lda, ipiv, info)
+      import :: dp
+      integer, intent(in) :: m, n, lda
+      real(dp), intent(inout) :: a(lda, *)
+      integer, intent(out) :: ipiv(*), info
+    end subroutine dgetrf
+    subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+      import :: dp
+      character, intent(in) :: trans
+      integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+      real(dp), intent(in) :: a(lda, *)
+      real(dp), intent(inout) :: b(ldb, *)
+      integer, intent(out) :: info
+    end subroutine dgetrs
   end interface
 end module casca_lapack

@@ -24,9 +24,13 @@ module casca_linear_system
   !> Constraint rows in MUMPS's coordinates: entries (neq + k, eq) of dg_k/dq, a zero
   !> diagonal (neq + k, neq + k) per multiplier, and the gaps; key(2, k): the (node, element)
   !> of constraint k, which identifies its row while the point is held
+  !> fval: the columns through which the multipliers act (C^T, but for sliding friction
+  !> (C_n - mu_d C_s)^T: its force follows |lambda|), same entries as val; the Schur path
+  !> uses them (S = C K^-1 B^T, unsymmetric), the saddle path does not (MUMPS's matrix is
+  !> symmetric there: sliding converges by fixed point)
   type :: rows_t
     integer, allocatable :: irn(:), jcn(:), key(:, :)
-    real(dp), allocatable :: val(:), gap(:)
+    real(dp), allocatable :: val(:), gap(:), fval(:)
   end type rows_t
 
   type :: linear_system_t
@@ -165,11 +169,12 @@ contains
       bb = 0
       bb(:, 1) = b(1:asm%neq)
       do e = 1, size(rows%irn)
-        if (rows%irn(e) /= rows%jcn(e)) bb(rows%jcn(e), 1 + rows%irn(e) - asm%neq) = rows%val(e)
+        if (rows%irn(e) /= rows%jcn(e)) bb(rows%jcn(e), 1 + rows%irn(e) - asm%neq) = rows%fval(e)
       end do
       call solve_blocks(ls, asm, bb, yy, 0, err)
       if (allocated(err)) return
-      call schur_store(ls%cache, asm%neq, rows%irn, rows%jcn, rows%val, rows%key, yy(:, 2:), err)
+      call schur_store(ls%cache, asm%neq, rows%irn, rows%jcn, rows%val, rows%key, yy(:, 2:), err, &
+                       any(rows%fval /= rows%val))
       if (allocated(err)) return
     else                    ! the kept Z and S: one right-hand side
       allocate (yy(asm%neq, 1))

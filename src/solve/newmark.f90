@@ -9,6 +9,9 @@ module casca_newmark
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_correction, only: contact_correction, add_impulses
+  use casca_contact_projection, only: positions
+  use casca_contact_friction, only: friction_step_done
+  use casca_contact_rows, only: obstacle_power
   use casca_timers, only: timer_start, timer_stop, t_contact
   implicit none
   private
@@ -57,6 +60,7 @@ contains
     if (present(contact)) then
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
+      contact%x_start = positions(model, st%q); contact%dt = dt   ! (friction's slip)
     end if
     call attempt()
     if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
@@ -74,7 +78,7 @@ contains
       end do
       if (size(released) > 0) then
         call timer_start(t_contact)
-        call add_impulses(ls%mass, released, released%lambda - released%mu, model, a0, err)
+        call add_impulses(ls%mass, released, model, a0, err)
         call timer_stop(t_contact)
         if (allocated(err)) return
         iters = rep%iters
@@ -86,6 +90,10 @@ contains
         end if
         rep%iters = rep%iters + iters
       end if
+    end if
+    if (present(contact)) then   ! (the end-of-step forces over the step)
+      call friction_step_done(contact)
+      contact%obstacle_work = contact%obstacle_work + dt*obstacle_power(contact)
     end if
     st%q = q; st%qd = qd; st%qdd = qdd
     st%t = st%t + dt

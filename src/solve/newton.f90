@@ -25,7 +25,9 @@ module casca_newton
                                  kkt_solve, negative_pivots
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_active_set, only: contact_update, contact_release
-  use casca_contact_rows, only: contact_rows, contact_generalized_force
+  use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_nrows, &
+                                contact_multipliers, contact_set_multipliers, contact_max_gap
+  use casca_contact_friction, only: friction_update
   use casca_mpi, only: is_root, sum_all
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve
@@ -97,6 +99,7 @@ contains
     allocate (r(model%ndof), res(model%ndof))
     q_entry = q
     if (present(contact)) then
+      contact%act(1:contact%nact)%flips = 0
       act_entry = contact%act(1:contact%nact)
       contact%changes = 0
     end if
@@ -158,12 +161,12 @@ contains
       if (present(contact)) then
         call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
                             reproject=reproject)
-        nc = contact%nact
-        call contact_rows(contact, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap)
-        rows%key = reshape([(contact%act(k)%node, contact%act(k)%elem, k=1, nc)], [2, nc])
+        nc = contact_nrows(contact)
+        call contact_rows(contact, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, &
+                          rows%key, rows%fval)
         version = contact%changes
       else if (.not. allocated(rows%gap)) then
-        allocate (rows%irn(0), rows%jcn(0), rows%val(0), rows%gap(0), rows%key(2, 0))
+        allocate (rows%irn(0), rows%jcn(0), rows%val(0), rows%gap(0), rows%key(2, 0), rows%fval(0))
       end if
       call timer_stop(t_contact)
     end subroutine constraints
@@ -262,7 +265,7 @@ contains
     subroutine move_to(alpha)
       real(dp), intent(in) :: alpha
       q = inc%q + alpha*inc%dq
-      if (size(inc%lambda) > 0) contact%act(1:size(inc%lambda))%lambda = inc%lambda + alpha*inc%dlambda
+      if (size(inc%lambda) > 0) call contact_set_multipliers(contact, inc%lambda + alpha*inc%dlambda)
     end subroutine move_to
 
     !> solve the saddle-point system for (dq, dlambda) and step
@@ -294,7 +297,7 @@ contains
       call timer_stop(t_solve)
       inc%q = q; inc%dq = d(1:model%ndof); inc%dlambda = d(model%ndof + 1:)
       if (nc > 0) then
-        inc%lambda = contact%act(1:nc)%lambda
+        inc%lambda = contact_multipliers(contact)
       else
         inc%lambda = [real(dp) ::]
       end if
@@ -330,14 +333,20 @@ contains
     !> also measures the gaps at the new iterate). True when the set changed; an error when
     !> it keeps changing.
     logical function set_changed()
-      integer :: released, added
+      integer :: released, added, slipped
       set_changed = .false.
       if (.not. present(contact)) return
       call timer_start(t_contact)
-      call contact_release(contact, released)
-      call contact_update(contact, model, q, .true., added, reproject=.false.)
+      ! stick/slip first: a trial stick's multiplier may be tensile only because it stopped
+      ! the sliding (the node would then be released and taken again, step after step)
+      released = 0; added = 0
+      call friction_update(contact, slipped)
+      if (slipped == 0) then
+        call contact_release(contact, released)
+        call contact_update(contact, model, q, .true., added, reproject=.false.)
+      end if
       call timer_stop(t_contact)
-      set_changed = released > 0 .or. added > 0
+      set_changed = released > 0 .or. added > 0 .or. slipped > 0
       if (set_changed .and. contact%changes >= max_set_changes) &
         call fatal_error(err, 'the contact active set did not settle')
     end function set_changed
@@ -346,7 +355,7 @@ contains
     logical function gap_open()
       gap_open = .false.
       if (.not. present(contact)) return
-      if (contact%nact > 0) gap_open = maxval(abs(contact%act(1:contact%nact)%gap)) > contact%tol
+      gap_open = contact_max_gap(contact) > contact%tol
     end function gap_open
 
     function failure_message() result(msg)

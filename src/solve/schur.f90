@@ -10,7 +10,7 @@ module casca_schur
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_mpi, only: sum_all
-  use casca_lapack, only: dsyev, dpotrf, dpotrs
+  use casca_lapack, only: dsyev, dpotrf, dpotrs, dgetrf, dgetrs
   implicit none
   private
   public :: schur_t, schur_valid, schur_store, schur_apply
@@ -23,6 +23,7 @@ module casca_schur
     real(dp), allocatable :: val(:)
     logical :: current = .false.          !< made with the factors of K in use
     logical :: cholesky = .true.
+    integer, allocatable :: pivots(:)     !< LU's, when S is unsymmetric (sliding friction)
     integer :: positive = 0               !< positive eigenvalues of S
   end type schur_t
 
@@ -40,17 +41,32 @@ contains
   end function schur_valid
 
   !> Keep the rows and Z, form S = C Z (summed over the ranks) and factorise it.
-  subroutine schur_store(c, neq, irn, jcn, val, key, z, err)
+  !> unsym: Z = K^-1 B^T with B /= C: S is factorised by LU (its inertia is not counted)
+  subroutine schur_store(c, neq, irn, jcn, val, key, z, err, unsym)
     type(schur_t), intent(inout) :: c
     integer, intent(in) :: neq, irn(:), jcn(:), key(:, :)
     real(dp), intent(in) :: val(:), z(:, :)
     type(error_t), allocatable, intent(out) :: err
+    logical, intent(in) :: unsym
     real(dp), allocatable :: work(:)
     integer :: nc, info
     nc = size(key, 2)
     c%irn = irn; c%jcn = jcn; c%val = val; c%key = key; c%z = z
     c%current = .true.
+    if (allocated(c%pivots)) deallocate (c%pivots)
     call form_s()
+    if (unsym) then
+      c%cholesky = .false.
+      allocate (c%pivots(nc))
+      call dgetrf(nc, nc, c%s, nc, c%pivots, info)
+      c%positive = nc
+      if (info /= 0) then
+        c%current = .false.
+        call fatal_error(err, 'contact constraints are dependent (singular Schur complement)')
+      end if
+      return
+    end if
+    c%s = 0.5_dp*(c%s + transpose(c%s))
     c%cholesky = .true.
     call dpotrf('L', nc, c%s, nc, info)
     if (info == 0) then
@@ -59,6 +75,7 @@ contains
     end if
     c%cholesky = .false.   ! not positive definite: S again, into eigenvalues
     call form_s()
+    c%s = 0.5_dp*(c%s + transpose(c%s))
     if (allocated(c%eig)) deallocate (c%eig)
     allocate (c%eig(nc), work(max(1, 4*nc)))
     call dsyev('V', 'L', nc, c%s, nc, c%eig, work, size(work), info)
@@ -79,7 +96,6 @@ contains
         c%s(k, :) = c%s(k, :) + val(e)*z(jcn(e), :)
       end do
       call sum_all(c%s)
-      c%s = 0.5_dp*(c%s + transpose(c%s))
     end subroutine form_s
   end subroutine schur_store
 
@@ -102,7 +118,9 @@ contains
     end do
     call sum_all(rhs)
     rhs = rhs + gap
-    if (c%cholesky) then
+    if (allocated(c%pivots)) then
+      call dgetrs('N', nc, 1, c%s, nc, c%pivots, rhs, nc, info)
+    else if (c%cholesky) then
       call dpotrs('L', nc, 1, c%s, nc, rhs, nc, info)
     else
       rhs = matmul(c%s, matmul(rhs, c%s)/c%eig)
