@@ -1,9 +1,9 @@
 !> Numbers as text for messages (one home for what every module that writes messages needs).
 module casca_strings
-  use, intrinsic :: iso_fortran_env, only: int32, int64
+  use, intrinsic :: iso_fortran_env, only: int32, int64, real64
   implicit none
   private
-  public :: itoa
+  public :: itoa, rtoa
 
   !> n as its shortest decimal text (default and 64-bit integers, e.g. HDF5's hsize_t)
   interface itoa
@@ -25,4 +25,13 @@ contains
     write (b, '(i0)') n
     s = trim(b)
   end function itoa_i64
+
+  !> x in scientific notation with 5 significant digits, e.g. 2.4190E+04
+  pure function rtoa(x) result(s)
+    real(real64), intent(in) :: x
+    character(len=:), allocatable :: s
+    character(len=24) :: b
+    write (b, '(es12.4)') x
+    s = trim(adjustl(b))
+  end function rtoa
 end module casca_strings

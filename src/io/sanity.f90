@@ -6,7 +6,7 @@ module casca_sanity
   use casca_deck, only: deck_t, obstacle_cfg_t, add_problem, unset, deck_file
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
   use casca_mesh_generators, only: generated_elements, max_generated_elements
-  use casca_strings, only: itoa
+  use casca_strings, only: itoa, rtoa
   implicit none
   private
   public :: check_deck, parse_fix
@@ -42,7 +42,7 @@ contains
         if (r%dt > 0 .and. r%t_end > 0 .and. r%t_end <= max_real) then
           if (r%dt > r%t_end) call add_problem(deck, l, '&run: dt is larger than t_end')
           if (r%t_end/r%dt > max_steps) call add_problem(deck, l, '&run: t_end/dt = '// &
-            num(r%t_end/r%dt)//' steps, more than the 1e9 a run can count')
+            rtoa(r%t_end/r%dt)//' steps, more than the 1e9 a run can count')
         end if
         call positive(l, '&run: beta', r%beta)
         call finite(l, '&run: gamma', [r%gamma])
@@ -73,7 +73,7 @@ contains
       if (o%vtu .and. o%interval > 0 .and. deck%run%t_end > 0 .and. deck%run%dt > 0 .and. &
           deck%run%t_end <= max_real) then
         if (deck%run%t_end/max(o%interval, deck%run%dt) > max_frames) call add_problem(deck, l, &
-          '&output: interval gives '//num(deck%run%t_end/max(o%interval, deck%run%dt))// &
+          '&output: interval gives '//rtoa(deck%run%t_end/max(o%interval, deck%run%dt))// &
           ' frames, more than the 99999 of frame_NNNNN.vtu')
       end if
       if (len_trim(o%dir) == 0) call add_problem(deck, l, '&output: dir is empty')
@@ -228,13 +228,13 @@ contains
       character(len=*), intent(in) :: group
       real(dp), intent(in) :: dyn, sta
       if (.not. (dyn >= 0 .and. dyn < 10)) call add_problem(deck, line, group// &
-        ': friction must be in [0, 10) (got '//num(dyn)//')')
+        ': friction must be in [0, 10) (got '//rtoa(dyn)//')')
       if (sta == unset) return
       if (.not. (sta >= 0 .and. sta < 10)) then
-        call add_problem(deck, line, group//': static_friction must be in [0, 10) (got '//num(sta)//')')
+        call add_problem(deck, line, group//': static_friction must be in [0, 10) (got '//rtoa(sta)//')')
       else if (sta < dyn) then
-        call add_problem(deck, line, group//': static_friction ('//num(sta)// &
-                         ') must not be below friction ('//num(dyn)//')')
+        call add_problem(deck, line, group//': static_friction ('//rtoa(sta)// &
+                         ') must not be below friction ('//rtoa(dyn)//')')
       end if
     end subroutine check_friction
 
@@ -253,9 +253,9 @@ contains
       if (v == unset) then
         call add_problem(deck, line, field//' is missing')
       else if (.not. (v > 0)) then
-        call add_problem(deck, line, field//' must be > 0 (got '//num(v)//')')
+        call add_problem(deck, line, field//' must be > 0 (got '//rtoa(v)//')')
       else if (.not. (v <= max_real)) then
-        call add_problem(deck, line, field//' must be > 0 and below 1e30 (got '//num(v)//')')
+        call add_problem(deck, line, field//' must be > 0 and below 1e30 (got '//rtoa(v)//')')
       end if
     end subroutine positive
 
@@ -265,7 +265,7 @@ contains
       character(len=*), intent(in) :: field
       real(dp), intent(in) :: v(:)
       if (.not. all(abs(v) <= max_real)) call add_problem(deck, line, field// &
-        ' must be finite numbers below 1e30 in size (got '//num(v(maxloc(merge(1, 0, &
+        ' must be finite numbers below 1e30 in size (got '//rtoa(v(maxloc(merge(1, 0, &
         .not. abs(v) <= max_real), dim=1)))//')')
     end subroutine finite
 
@@ -274,7 +274,7 @@ contains
       integer, intent(in) :: line, n1, n2
       character(len=*), intent(in) :: name, kind
       if (generated_elements(kind, n1, n2) > max_generated_elements) call add_problem(deck, &
-        line, '&body '//trim(name)//': the sizes give '//num(generated_elements(kind, n1, n2))// &
+        line, '&body '//trim(name)//': the sizes give '//rtoa(generated_elements(kind, n1, n2))// &
         ' elements, more than the 1e7 a generator makes')
     end subroutine check_size
 
@@ -298,17 +298,10 @@ contains
       if (size(elems) == 0 .or. physical_memory() <= 0) return
       if (sum(elems)*bytes_per_element > real(physical_memory(), dp)) &   ! (at the largest body)
         call add_problem(deck, deck%bodies(maxloc(elems, dim=1))%line, 'the generated meshes '// &
-          'have '//num(sum(elems))//' elements in all, needing about '//num(sum(elems)*bytes_per_element/1e9_dp)// &
-          ' GB of memory; this machine has '//num(real(physical_memory(), dp)/1e9_dp)//' GB')
+          'have '//rtoa(sum(elems))//' elements in all, needing about '//rtoa(sum(elems)*bytes_per_element/1e9_dp)// &
+          ' GB of memory; this machine has '//rtoa(real(physical_memory(), dp)/1e9_dp)//' GB')
     end subroutine check_memory
 
-    function num(v) result(str)
-      real(dp), intent(in) :: v
-      character(len=:), allocatable :: str
-      character(len=32) :: b
-      write (b, '(es12.4e3)') v
-      str = trim(adjustl(b))
-    end function num
 
     integer function find_body(name)
       character(len=*), intent(in) :: name

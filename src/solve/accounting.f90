@@ -8,6 +8,7 @@ module casca_accounting
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
   use casca_vectors, only: cross
+  use casca_strings, only: rtoa
   implicit none
   private
   public :: balance_t, energy_term_t, account, gravity_load, balance_summary, energy_balance
@@ -133,26 +134,19 @@ contains
     real(dp) :: rest
     integer :: k
     rest = b0%total - (b%kinetic + b%strain - b%work)
-    line = 'energy balance: E0 = '//num(b0%total)//' J, kinetic '//num(b%kinetic)//', strain '// &
-           num(b%strain)//', work of loads '//num(b%work)
+    line = 'energy balance: E0 = '//rtoa(b0%total)//' J, kinetic '//rtoa(b%kinetic)//', strain '// &
+           rtoa(b%strain)//', work of loads '//rtoa(b%work)
     if (present(extra)) then
       do k = 1, size(extra)
-        line = line//', '//extra(k)%name//' '//num(extra(k)%value)
+        line = line//', '//extra(k)%name//' '//rtoa(extra(k)%value)
         rest = rest - extra(k)%value
       end do
     end if
-    line = line//', removed by the time integrator and contact '//num(rest)
+    line = line//', removed by the time integrator and contact '//rtoa(rest)
     if (abs(rest) < 1e6_dp*abs(b0%total)) then   ! (not of an E0 that is zero or nearly)
       line = line//' ('//pct(100*rest/abs(b0%total))//'% of E0)'
     end if
   contains
-    function num(x) result(str)
-      real(dp), intent(in) :: x
-      character(len=:), allocatable :: str
-      character(len=16) :: w
-      write (w, '(es11.4)') x
-      str = trim(adjustl(w))
-    end function num
     function pct(x) result(str)
       real(dp), intent(in) :: x
       character(len=:), allocatable :: str
