@@ -339,9 +339,10 @@ contains
         terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
     end function extra_terms
 
-    !> each pair's coefficients: its obstacle's, else &contact's; static defaults to dynamic
+    !> each pair's coefficients: its obstacle's, or its own in &contact (the listed pair of
+    !> the same two bodies, either way round), else &contact's; static defaults to dynamic
     subroutine set_friction()
-      integer :: p, t
+      integer :: p, t, j
       real(dp) :: d, st_
       do p = 1, contact%npairs
         d = deck%contact%friction; st_ = deck%contact%static_friction
@@ -349,11 +350,26 @@ contains
         if (t < 0) then
           if (deck%obstacles(-t)%friction /= unset) d = deck%obstacles(-t)%friction
           if (deck%obstacles(-t)%static_friction /= unset) st_ = deck%obstacles(-t)%static_friction
+        else
+          do j = 1, deck%contact%npairs
+            if (.not. same_bodies(j, contact%pair(1, p), t)) cycle
+            if (deck%contact%pair_friction(j) /= unset) d = deck%contact%pair_friction(j)
+            if (deck%contact%pair_static_friction(j) /= unset) st_ = deck%contact%pair_static_friction(j)
+          end do
         end if
         contact%mu_d(p) = d
         contact%mu_s(p) = merge(st_, d, st_ /= unset)
       end do
     end subroutine set_friction
+
+    !> listed pair j is bodies a and b, either way round
+    logical function same_bodies(j, a, b)
+      integer, intent(in) :: j, a, b
+      associate (names => deck%contact%pairs(:, j))
+        same_bodies = (names(1) == model%body(a)%name .and. names(2) == model%body(b)%name) .or. &
+                      (names(2) == model%body(a)%name .and. names(1) == model%body(b)%name)
+      end associate
+    end function same_bodies
 
     subroutine history_row(newton)
       integer, intent(in) :: newton

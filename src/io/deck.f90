@@ -99,6 +99,8 @@ module casca_deck
     integer :: passes = 1                       !< 2: each body of a pair impacts the other too
     real(dp) :: friction = 0                    !< Coulomb: dynamic coefficient
     real(dp) :: static_friction = unset         !< static coefficient (default: friction)
+    !> per listed pair (pairs(:, k)): its own coefficients (default: the two above)
+    real(dp) :: pair_friction(max_pairs) = unset, pair_static_friction(max_pairs) = unset
     integer :: line = 0
   end type contact_cfg_t
 
@@ -498,13 +500,15 @@ contains
     character(len=long) :: solver, normal, surface
     character(len=256) :: pairs(2, max_pairs)   ! (longer than a name: enough to see one too long)
     real(dp) :: tolerance, friction, static_friction
+    real(dp) :: pair_friction(max_pairs), pair_static_friction(max_pairs)
     character(len=256) :: msg
     integer :: ios, k, passes
     namelist /contact/ enabled, pairs, tolerance, solver, normal, surface, passes, friction, &
-      static_friction
+      static_friction, pair_friction, pair_static_friction
     associate (c => deck%contact)
       enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver; normal = c%normal
       surface = c%surface; passes = c%passes; friction = c%friction; static_friction = c%static_friction
+      pair_friction = c%pair_friction; pair_static_friction = c%pair_static_friction
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -517,6 +521,7 @@ contains
       call take(deck, line, '&contact: normal', lower(normal), c%normal)
       call take(deck, line, '&contact: surface', lower(surface), c%surface)
       c%passes = passes; c%friction = friction; c%static_friction = static_friction
+      c%pair_friction = pair_friction; c%pair_static_friction = pair_static_friction
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit

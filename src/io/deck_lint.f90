@@ -49,7 +49,7 @@ contains
     case ('contact')
       select case (key)
       case ('pairs', 'solver', 'normal', 'surface'); t = 's'
-      case ('tolerance', 'friction', 'static_friction'); t = 'r'
+      case ('tolerance', 'friction', 'static_friction', 'pair_friction', 'pair_static_friction'); t = 'r'
       case ('passes'); t = 'i'
       case ('enabled'); t = 'l'
       end select

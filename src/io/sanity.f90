@@ -189,6 +189,18 @@ contains
     if (deck%contact%passes /= 1 .and. deck%contact%passes /= 2) &
       call add_problem(deck, deck%contact%line, '&contact: passes must be 1 or 2')
     call check_friction(deck%contact%line, '&contact', deck%contact%friction, deck%contact%static_friction)
+    do j = 1, size(deck%contact%pair_friction)
+      associate (c => deck%contact)
+        if (c%pair_friction(j) == unset .and. c%pair_static_friction(j) == unset) cycle
+        if (j > c%npairs) then
+          call add_problem(deck, c%line, '&contact: pair_friction('//itoa(j)//') given for pair '// &
+                           itoa(j)//', but pairs lists '//itoa(c%npairs))
+          cycle
+        end if
+        call check_friction(c%line, '&contact: pair '//itoa(j), merge(c%pair_friction(j), c%friction, &
+                            c%pair_friction(j) /= unset), c%pair_static_friction(j))
+      end associate
+    end do
     do i = 1, size(deck%obstacles)
       call check_obstacle(deck%obstacles(i))
     end do
