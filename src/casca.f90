@@ -121,7 +121,7 @@ contains
       if (is_root()) write (0, '(a)') 'error: check: usage: casca check DECK'
       code = exit_input; return
     end if
-    call load_scene(arg(2), deck, model, code)
+    call load_scene(arg(2), deck, model, code, gaps=.true.)
     if (code == exit_ok .and. is_root()) print '(a,i0,a,i0,a,i0,a,i0,a)', arg(2)//': ok: ', &
       model%nbody, ' bodies, ', model%nelem, ' elements, ', model%nnode, ' nodes, ', &
       count(.not. model%fixed), ' unknowns'

@@ -7,7 +7,9 @@ A block-like steel strip (0.2 x 0.1 m, h 20 mm, 2 x 1 elements) rests on a rigid
 slide      thrown at v0 = 1 m/s with mu = 0.3: between 0.05 s and 0.25 s it decelerates at
            mu g (1%); it stops after v0^2 / (2 mu g) = 0.1699 m (1%); the friction work in the
            history equals the kinetic energy lost, 1/2 m v0^2 (1%); the energy balance's
-           remainder (integrator and contact) stays below 1% of E0.
+           remainder (integrator and contact) stays below 1% of E0. Stopped at 0.15 s (sliding)
+           and restarted from its checkpoint, it repeats the uninterrupted run (x and friction
+           work to 1e-12: the stick/slip state, slip direction and work are in the checkpoint).
 stick      at rest, pushed by a total force F = mu m g / 2 along x: it does not move (1e-9 m)
            and the friction force equals F (1e-6 relative).
 pull       pushed by F = 1.5 mu m g: it accelerates at (F - mu m g) / m (1%).
@@ -75,6 +77,21 @@ if h is not None:
     line = [l for l in out.splitlines() if l.startswith("energy balance")]
     pct = float(line[0].split("(")[-1].split("%")[0]) if line else 100.0
     ck.le("slide: energy balance remainder [% of E0]", abs(pct), 1.0)
+
+    # restart: the same slide stopped at 0.15 s (mid-slide) and restarted from its checkpoint
+    part = os.path.join(work, "slide_part")
+    for name, t_end, extra in (("slide_part", 0.15, []), ("slide_rest", 0.5, ["--restart", os.path.join(part, "checkpoint.h5")])):
+        deck = os.path.join(work, name + ".nml")
+        with open(deck, "w") as f:
+            f.write(block_deck(velocity="1.0", t_end=t_end))
+        p = run([casca, "run", deck, "--out", part, "-q"] + extra)
+        ck.record("restart: %s runs (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
+    r = history(part)
+    if len(r["t"]) == len(h["t"]):
+        ck.le("restart: largest difference of x and friction work from the uninterrupted run",
+              max(np.max(np.abs(r["p1_x"] - h["p1_x"])), np.max(np.abs(r["friction_work"] - h["friction_work"]))), 1e-12)
+    else:
+        ck.record("restart: as many rows as the uninterrupted run", False, "%d vs %d" % (len(r["t"]), len(h["t"])))
 
 F = MU * m_block * G / 2
 h, _ = go("stick", block_deck(load=f"&load body = 'block', force = {F}, 0.0, 0.0 /\n"))

@@ -25,6 +25,7 @@ module casca_run
   use casca_contact_friction, only: pair_tangential_force
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
+  use casca_pair_gaps, only: pair_gap_t, pair_gaps, pair_gap_lines
   use casca_free_flight, only: idle_bodies, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
@@ -37,16 +38,21 @@ module casca_run
 contains
 
   !> Read, check and build; print every problem on rank 0. code = exit_input on problems.
-  subroutine load_scene(path, deck, model, code)
+  !> gaps: also print each contact pair's initial gap and time to contact (casca check).
+  subroutine load_scene(path, deck, model, code, gaps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(out) :: deck
     type(model_t), intent(out) :: model
     integer, intent(out) :: code
+    logical, intent(in), optional :: gaps
     integer :: i
     call read_deck(path, deck)
     if (deck%nproblems == 0) call check_deck(deck)
     if (deck%nproblems == 0) call build_model(deck, model)
     if (deck%nproblems == 0) call check_overlap()
+    if (present(gaps)) then
+      if (gaps .and. deck%nproblems == 0) call gap_report()
+    end if
     code = exit_ok
     if (deck%nproblems > 0) then
       if (is_root()) then
@@ -84,6 +90,37 @@ contains
                              'thickness from the mid-surface)'
       call add_problem(deck, 0, trim(msg))
     end subroutine check_overlap
+
+    !> each pair's gap and time to contact at t = 0 (pair_gaps.f90), on rank 0
+    subroutine gap_report()
+      type(contact_t) :: probe
+      type(state_t) :: st0
+      type(pair_gap_t), allocatable :: pg(:)
+      character(len=320), allocatable :: lines(:)
+      character(len=64), allocatable :: bnames(:), onames(:)
+      integer, allocatable :: pairs(:, :)
+      integer :: k, n
+      allocate (pairs, source=contact_pairs(deck, model))
+      if (size(pairs, 2) == 0 .or. .not. is_root()) return
+      call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
+                        deck%contact%surface == 'faces', probe)
+      call initial_state(deck, model, st0)
+      pg = pair_gaps(probe, model, reshape(st0%q([((dof(n, k), k=1, 3), n=1, model%nnode)]), &
+                     [3, model%nnode]), reshape(st0%q([((dof(n, k), k=4, 6), n=1, model%nnode)]), &
+                     [3, model%nnode]), reshape(st0%qd([((dof(n, k), k=1, 3), n=1, model%nnode)]), &
+                     [3, model%nnode]))
+      allocate (bnames(model%nbody), onames(size(probe%obstacle)))
+      do k = 1, model%nbody
+        bnames(k) = model%body(k)%name
+      end do
+      do k = 1, size(onames)
+        onames(k) = probe%obstacle(k)%name
+      end do
+      lines = pair_gap_lines(probe, pg, bnames, onames)
+      do k = 1, size(lines)
+        print '(a)', trim(lines(k))
+      end do
+    end subroutine gap_report
 
     !> a body's name, or an obstacle's (target -k)
     function target_name(t) result(name)

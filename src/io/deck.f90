@@ -397,7 +397,7 @@ contains
         call add_problem(deck, n + 1, 'unreadable line'); exit
       end if
       n = n + 1
-      text = [text, line]
+      text = [character(len=max_line_len) :: text, line]
       line = adjustl(line)
       if (line(1:1) /= '&') cycle
       j = scan(line(2:), ' /,'//achar(9))

@@ -1,0 +1,121 @@
+"""`casca check` prints each contact pair's initial gap and time to contact (issue 16).
+
+usage: test_check_report.py CASCA MESH_DIR WORK_DIR
+
+Scenes written for this test; every expected figure is the hand-computed geometry of the deck
+(the meshes' nodes lie on the exact circles, printed with 8 significant digits, so exact
+figures are compared to 1e-6 relative):
+rings faces    two thesis rings (R 1, h 0.05), centres 2.1 m apart, ring1 at (10, 3, 0) m/s, ring2
+               at (4, 0, 0) m/s: gap 2.1 - 2R - h = 0.05 m (node facing node), closing speed
+               10 - 4 = 6 m/s (along x, the line of closest approach), time 0.05 / 6 s.
+rings mid      the same with surface = 'mid': gap 0.1 m, time 0.1 / 6 s.
+rings between  ring2 turned by 3 degrees (half the 6-degree node spacing), so ring1's nearest node
+               faces a chord of ring2's: the printed gap lies between the exact gap 0.05 m and
+               0.05 + (R + h/2)(1 - cos 3 deg) (the chord's sagitta at the face: the accuracy the
+               output states), and the time is that gap / 6 m/s.
+obstacles      a ring (R 0.2, h 0.04) at (1, -2, 0) m/s above a floor plane 0.3 m below its centre:
+               gap 0.3 - R - h/2 = 0.08 m, closing 2 m/s, time 0.04 s; a rigid sphere (radius 0.2)
+               centred 0.5 m above it falling at 5 m/s: the ring's nodes across its width w = 0.05
+               are at z = +-w/6, +-w/2, so its nearest node is at D = sqrt(0.3^2 + (w/6)^2) from
+               the centre, off the vertical by c = 0.3 / D: gap D - 0.2 - (h/2) c (the face along
+               the radial fibre, projected on the line to the centre, as a constraint measures
+               it), closing speed 3 c m/s, time gap / (3 c); the same sphere at rest: 'never'
+               (the ring moves away from it).
+self-contact   the ring's pair with itself: time to contact 'never' (its rigid motion closes no gap).
+"""
+import math
+import os
+import re
+import sys
+
+from casca_testlib import Checks, run
+
+casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
+os.makedirs(work, exist_ok=True)
+ck = Checks()
+STEEL = "young = 210e9, poisson = 0.3, density = 7700"
+LINE = re.compile(r"pair '([^']*)' -> '([^']*)'[^:]*: gap\s+(\S+) m, closing speed\s+(\S+) m/s, "
+                  r"time to contact (never|\S+ s)")
+
+
+def check(name, text):
+    """run casca check on the deck text: {(impactor, target): (gap, speed, time or None)}"""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text)
+    p = run([casca, "check", deck])
+    ck.record("%s: casca check exit 0" % name, p.returncode == 0, p.stderr[-300:])
+    pairs = {}
+    for m in LINE.finditer(p.stdout):
+        t = None if m.group(5) == "never" else float(m.group(5).split()[0])
+        pairs[(m.group(1), m.group(2))] = (float(m.group(3)), float(m.group(4)), t)
+    print(p.stdout.strip())
+    return pairs
+
+
+def close(name, value, expected, rtol=1e-6):
+    if value is None:
+        ck.record(name, False, "not printed")
+    else:
+        ck.close(name, value, expected, rtol)
+
+
+ring = os.path.join(meshdir, "ring_20x1.msh")
+R, h = 1.0, 0.05
+
+
+def rings(surface, turn=0.0):
+    return f"""&run dt = 5.0e-5, t_end = 1.0e-3 /
+&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = 10.0, 3.0, 0.0, {STEEL}, thickness = {h} /
+&body name = 'ring2', mesh = 'file', file = '{ring}', center = 2.1, 0.0, 0.0, velocity = 4.0, 0.0, 0.0,
+  rotate_axis = 0.0, 0.0, 1.0, rotate_angle = {turn}, {STEEL}, thickness = {h} /
+&contact surface = '{surface}' /
+"""
+
+
+for surface, gap in (("faces", 2.1 - 2 * R - h), ("mid", 2.1 - 2 * R)):
+    pr = check("rings_" + surface, rings(surface)).get(("ring1", "ring2"), (None,) * 3)
+    close("rings %s: gap [m]" % surface, pr[0], gap)
+    close("rings %s: closing speed [m/s]" % surface, pr[1], 6.0)
+    close("rings %s: time to contact [s]" % surface, pr[2], gap / 6.0)
+
+pr = check("rings_between", rings("faces", 3.0)).get(("ring1", "ring2"), (None,) * 3)
+exact, sag = 2.1 - 2 * R - h, (R + h / 2) * (1 - math.cos(math.radians(3.0)))
+if pr[0] is None:
+    ck.record("rings between nodes: printed", False)
+else:
+    ck.record("rings between nodes: exact gap <= printed <= exact + the chord's sagitta at the face",
+              exact * (1 - 1e-6) <= pr[0] <= (exact + sag) * (1 + 1e-6),
+              "%.8g in [%.8g, %.8g]" % (pr[0], exact, exact + sag))
+    close("rings between nodes: time = printed gap / 6 m/s", pr[2], pr[0] / 6.0)
+
+small = os.path.join(work, "ring_r02.msh")
+run([casca, "mesh", "ring", "--radius", "0.2", "--width", "0.05", "--n-around", "20", "--n-across", "1", "-o", small])
+r, hr = 0.2, 0.04
+
+
+def ring_obstacles(ball_v):
+    return f"""&run dt = 2.0e-5, t_end = 1.0e-3 /
+&body name = 'ring', mesh = 'file', file = '{small}', velocity = 1.0, -2.0, 0.0, {STEEL}, thickness = {hr} /
+&obstacle name = 'floor', shape = 'plane', point = 0.0, -0.3, 0.0, normal = 0.0, 1.0, 0.0 /
+&obstacle name = 'ball', shape = 'sphere', point = 0.0, 0.5, 0.0, radius = 0.2, velocity = 0.0, {ball_v}, 0.0 /
+&contact pairs = 'ring', 'ring' /
+"""
+
+
+got = check("obstacles", ring_obstacles(-5.0))
+fl, ball, own = (got.get(k, (None,) * 3) for k in (("ring", "floor"), ("ring", "ball"), ("ring", "ring")))
+close("floor: gap [m]", fl[0], 0.3 - r - hr / 2)
+close("floor: closing speed [m/s]", fl[1], 2.0)
+close("floor: time to contact [s]", fl[2], (0.3 - r - hr / 2) / 2.0)
+D = math.hypot(0.5 - r, 0.05 / 6)
+c = (0.5 - r) / D
+close("falling sphere: gap [m]", ball[0], D - 0.2 - hr / 2 * c)
+close("falling sphere: closing speed [m/s]", ball[1], 3.0 * c)
+close("falling sphere: time to contact [s]", ball[2], (D - 0.2 - hr / 2 * c) / (3.0 * c))
+ck.record("self-contact: printed, time to contact 'never'", ("ring", "ring") in got and own[2] is None, str(own))
+got = check("sphere_at_rest", ring_obstacles(0.0))
+ball = got.get(("ring", "ball"), (None,) * 3)
+ck.record("sphere at rest above a ring moving down: 'never'", ("ring", "ball") in got and ball[2] is None
+          and ball[1] is not None and ball[1] < 0, str(ball))
+ck.finish()
