@@ -409,7 +409,7 @@ contains
         cycle
       end if
       if (name == 'end') cycle
-      gname = [gname, name]; gline = [gline, n]
+      gname = [character(len=16) :: gname, name]; gline = [gline, n]
     end do
     rewind (u)
     do k = 1, size(gname)

@@ -65,7 +65,7 @@ contains
     do k = 1, ntrack
       write (p, '(a,i0)') 'p', k
       do c = 1, 6
-        cols = [cols, trim(p)//trim(suffix(c))]
+        cols = [character(len=col_len) :: cols, trim(p)//trim(suffix(c))]
       end do
     end do
     cols = [cols, (word('kinetic_'//trim(bodies(k))), k=1, size(bodies)), &
@@ -153,7 +153,7 @@ contains
         end if
         if (tt > tmax*(1 + 1e-12_dp) + tiny(1._dp)) exit
         out%nframes = out%nframes + 1
-        out%files = [out%files, buf(i2 + 6:i2 + 5 + index(buf(i2 + 6:), '"') - 1)]
+        out%files = [character(len=32) :: out%files, buf(i2 + 6:i2 + 5 + index(buf(i2 + 6:), '"') - 1)]
         out%times = [out%times, tt]
       end do
       close (uu)
@@ -337,7 +337,7 @@ contains
                    [field('body', body), field('von_mises', vm)], err)
     if (allocated(err)) return
     out%nframes = out%nframes + 1
-    out%files = [out%files, name]
+    out%files = [character(len=32) :: out%files, name]
     out%times = [out%times, st%t]
     call write_pvd(out%dir//'/run.pvd', out%files, out%times, err)
   end subroutine output_frame
