@@ -23,7 +23,9 @@ floor      a free ring (R 0.2, h 40 mm) at 2 m/s onto a fixed rigid plane (thesi
 pusher     the same ring at rest, struck by a plane moving at V = 2 m/s: the mid-surface of the
            tracked lowest node stays h/2 above the moving plane (within 2e-5 m: the face moves
            with the thickness strain, below 1e-3 here) and after contact the ring moves at least
-           at V (it cannot be overtaken by the plane that pushes it).
+           at V (it cannot be overtaken by the plane that pushes it). The plane's work in the
+           history (obstacle_work) equals V times the ring's momentum change, the plane's force
+           being the only force on it (1e-5: Newton's tolerance, as for the floor's impulse).
 bad input  unknown obstacle shape, a sphere without radius, contact surface 'top', passes 3:
            exit 2 naming the file, the group and the field.
 """
@@ -128,6 +130,8 @@ if h is not None:
     ck.record("pusher: contact happens", h["contacts"].max() > 0)
     ck.record("pusher: after contact the ring moves at least at V", h["contacts"][-1] == 0 and h["py"][-1] / m >= V,
               "vy %.4g m/s" % (h["py"][-1] / m))
+    ck.close("pusher: the plane's work [J] vs V times the ring's momentum change (its only force)",
+             h["obstacle_work"][-1], V * (h["py"][-1] - h["py"][0]), 1e-5)
 
 # --- bad input
 base = f"""&run dt = 1e-5, t_end = 1e-4 /

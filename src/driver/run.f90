@@ -216,7 +216,8 @@ contains
       else
         allocate (character(len=1) :: pair_names(0))
       end if
-      call output_open(out, dir, tracked, labels, body_names, pair_names, friction, restart_step, st%t, err)
+      call output_open(out, dir, tracked, labels, body_names, pair_names, friction, moving_obstacles(), &
+                       restart_step, st%t, err)
     end block
     if (failed('output')) return
 
@@ -367,14 +368,19 @@ contains
     !> the energy balance's terms that the scene has: friction's, moving obstacles'
     function extra_terms() result(terms)
       type(energy_term_t), allocatable :: terms(:)
-      integer :: k
       allocate (terms(0))
       if (.not. use_contact) return
       if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
                                                                sum(contact%friction_work))]
-      if (any([(any(deck%obstacles(k)%velocity /= 0), k=1, size(deck%obstacles))])) &
+      if (moving_obstacles()) &
         terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
     end function extra_terms
+
+    logical function moving_obstacles()
+      integer :: k
+      moving_obstacles = use_contact .and. any([(any(deck%obstacles(k)%velocity /= 0), &
+                                                 k=1, size(deck%obstacles))])
+    end function moving_obstacles
 
     !> each pair's coefficients: its obstacle's, or its own in &contact (the listed pair of
     !> the same two bodies, either way round), else &contact's; static defaults to dynamic
@@ -418,7 +424,7 @@ contains
         call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
                             max(pen, 0._dp), rep%neg_pivots, lmax, gmax, &
                             pair_normal_force(contact), pair_active_count(contact), err, &
-                            pair_tangential_force(contact), sum(contact%friction_work))
+                            pair_tangential_force(contact), sum(contact%friction_work), contact%obstacle_work)
       else
         call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, 0._dp, 0._dp, &
                             [real(dp) ::], [integer ::], err)

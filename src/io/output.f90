@@ -36,6 +36,7 @@ module casca_output
     integer, allocatable :: tracked(:)
     integer :: nbody = 0, npairs = 0    !< per-body and per-pair columns
     logical :: friction = .false.       !< the pairs' tangential forces and the friction work too
+    logical :: moving = .false.         !< the work of moving obstacles too
     integer :: rows = 0
     logical :: locked = .false.         !< this run holds the folder's lock
   end type output_t
@@ -50,11 +51,12 @@ contains
   !> contacts_P); the per-body and per-pair columns come last, so that the older ones keep
   !> their positions. Names are single words of letters, digits and '_' (anything else in a
   !> body's name becomes '_'), which numpy's genfromtxt(names=True) keeps as they are.
-  !> With friction, then ftangent_P per pair and friction_work (dissipated by sliding).
-  function history_columns(ntrack, bodies, pairs, friction) result(cols)
+  !> With friction, then ftangent_P per pair and friction_work (dissipated by sliding); with
+  !> moving obstacles, obstacle_work (done on the bodies).
+  function history_columns(ntrack, bodies, pairs, friction, moving) result(cols)
     integer, intent(in) :: ntrack
     character(len=*), intent(in) :: bodies(:), pairs(:)
-    logical, intent(in) :: friction
+    logical, intent(in) :: friction, moving
     character(len=col_len), allocatable :: cols(:)
     character(len=*), parameter :: suffix(6) = [character(len=3) :: '_x', '_y', '_z', '_vx', '_vy', '_vz']
     character(len=8) :: p
@@ -74,6 +76,7 @@ contains
             (word('contacts_'//trim(pairs(k))), k=1, size(pairs))]
     if (friction) cols = [cols, (word('ftangent_'//trim(pairs(k))), k=1, size(pairs)), &
                           word('friction_work')]
+    if (moving) cols = [cols, word('obstacle_work')]
   contains
     !> name with every character but letters, digits and '_' replaced by '_'
     pure function word(name) result(w)
@@ -91,9 +94,10 @@ contains
   !> Create the folder, lock it (casca_output_lock) and make the files; with restart_step >= 0
   !> keep what an earlier run wrote up to that step (and the frames up to restart_time) and
   !> append after it. bodies: the bodies' names; pairs: a label per contact pair.
-  subroutine output_open(out, dir, tracked, labels, bodies, pairs, friction, restart_step, restart_time, err)
+  subroutine output_open(out, dir, tracked, labels, bodies, pairs, friction, moving, restart_step, &
+                         restart_time, err)
     type(output_t), intent(out) :: out
-    logical, intent(in) :: friction
+    logical, intent(in) :: friction, moving
     character(len=*), intent(in) :: dir
     integer, intent(in) :: tracked(:)
     character(len=*), intent(in) :: labels(:), bodies(:), pairs(:)
@@ -107,7 +111,7 @@ contains
 
     out%dir = trim(dir)
     out%tracked = tracked
-    out%nbody = size(bodies); out%npairs = size(pairs); out%friction = friction
+    out%nbody = size(bodies); out%npairs = size(pairs); out%friction = friction; out%moving = moving
     allocate (out%files(0), out%times(0))
     if (.not. is_root()) return
     if (.not. make_dir(out%dir)) then
@@ -119,7 +123,7 @@ contains
     if (note /= '') write (0, '(a)') 'warning: '//note
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
-    cols = history_columns(size(tracked), bodies, pairs, friction)
+    cols = history_columns(size(tracked), bodies, pairs, friction, moving)
     if (restart_step < 0) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return
@@ -251,7 +255,8 @@ contains
   !> tracked nodes, kinetic and strain energy per body (bal), normal force and active
   !> constraints per contact pair (pair_force, pair_count: as many as output_open's pairs).
   subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, &
-                            lambda_max, gap_max, pair_force, pair_count, err, pair_tangent, friction_work)
+                            lambda_max, gap_max, pair_force, pair_count, err, pair_tangent, friction_work, &
+                            obstacle_work)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
@@ -260,7 +265,7 @@ contains
     real(dp), intent(in) :: pair_force(:)
     integer, intent(in) :: pair_count(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), intent(in), optional :: pair_tangent(:), friction_work
+    real(dp), intent(in), optional :: pair_tangent(:), friction_work, obstacle_work
     real(dp), allocatable :: row(:)
     character(len=max_line) :: line
     integer :: k, n
@@ -281,6 +286,7 @@ contains
     end if
     row = [row, bal%body_kinetic, bal%body_strain, pair_force, real(pair_count, dp)]
     if (out%friction) row = [row, pair_tangent, friction_work]
+    if (out%moving) row = [row, obstacle_work]
     write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
     call cf_write(out%hist, trim(line)//new_line('a'), err)
     if (allocated(err)) return
