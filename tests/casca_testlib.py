@@ -46,6 +46,18 @@ def run(args, np_ranks=1, cwd=None, timeout=3000):
     return subprocess.run(cmd, cwd=cwd, env=ENV, capture_output=True, text=True, timeout=timeout)
 
 
+def run_scene(casca, ck, work, name, text, quiet=True):
+    """Write deck text to WORK/NAME.nml, run it into WORK/NAME and record that it ran to the end
+    (exit 0). Returns the output folder (None on failure) and casca's standard output."""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text)
+    out = os.path.join(work, name)
+    p = run([casca, "run", deck, "--out", out] + (["-q"] if quiet else []))
+    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
+    return (out if p.returncode == 0 else None), p.stdout
+
+
 def history(folder):
     """history.dat as a dict of columns (numpy arrays), keyed by the header's names."""
     path = os.path.join(folder, "history.dat")

@@ -34,7 +34,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, run
+from casca_testlib import Checks, history, run, run_scene
 
 casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
 os.makedirs(work, exist_ok=True)
@@ -43,13 +43,8 @@ STEEL = "young = 210e9, poisson = 0.3, density = 7700"
 
 
 def go(name, text):
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write(text)
-    out = os.path.join(work, name)
-    p = run([casca, "run", deck, "--out", out, "-q"])
-    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
-    return history(out) if p.returncode == 0 else None
+    out, _ = run_scene(casca, ck, work, name, text)
+    return history(out) if out else None
 
 
 # --- faces: first contact of a strip falling flat

@@ -35,7 +35,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, run
+from casca_testlib import Checks, history, run, run_scene
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
 os.makedirs(work, exist_ok=True)
@@ -48,13 +48,8 @@ m_block = 7700 * 0.02 * 0.2 * 0.1
 
 
 def go(name, text):
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write(text)
-    out = os.path.join(work, name)
-    p = run([casca, "run", deck, "--out", out])
-    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
-    return (history(out), p.stdout) if p.returncode == 0 else (None, p.stdout)
+    out, stdout = run_scene(casca, ck, work, name, text, quiet=False)
+    return (history(out) if out else None), stdout
 
 
 def block_deck(velocity="0.0", load="", friction=f"friction = {MU}", t_end=0.5):

@@ -33,7 +33,7 @@ import xml.etree.ElementTree as ET
 import meshio
 import numpy as np
 
-from casca_testlib import Checks, history, run
+from casca_testlib import Checks, history, run, run_scene
 
 casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
 os.makedirs(work, exist_ok=True)
@@ -44,13 +44,7 @@ h = 0.05
 
 
 def go(name, text):
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write(text)
-    out = os.path.join(work, name)
-    p = run([casca, "run", deck, "--out", out, "-q"])
-    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
-    return out if p.returncode == 0 else None
+    return run_scene(casca, ck, work, name, text)[0]
 
 
 def frames(out):
