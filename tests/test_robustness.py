@@ -9,7 +9,8 @@ shipped      every deck in examples/ runs to its end with exit 0. test_scenes.py
              2 ranks: no test runs it to the end); test_cli.py only checks the decks. Every
              other deck is run here, from a copy: today that is cantilever.nml (statics, Sze's
              cantilever under end shear), whose tip deflections at P = 4 are compared with Sze,
-             Liu & Lo (2004).
+             Liu & Lo (2004), and hoop_rolling.nml (exit 0 here; its physics, the same scene, is
+             asserted in test_friction.py).
 slit         statics with large rotations from the default Newton settings: Sze's slit annular
              plate under an end line force (test 3.3), built here (tests/data/
              make_slit_annular_plate.py), 40 load steps; W_A and W_B at q = 0.2, 0.4 and 0.8
