@@ -12,7 +12,7 @@ module casca_obstacle
 
   type :: obstacle_t
     character(len=64) :: name = ''
-    character(len=8) :: shape = 'plane'
+    character(len=16) :: shape = 'plane'
     real(dp) :: point(3) = 0      !< plane: a point of it; sphere: centre; cylinder: a point of the axis
     real(dp) :: normal(3) = 0     !< plane: unit normal towards the bodies; cylinder: unit axis
     real(dp) :: radius = 0

@@ -5,7 +5,7 @@ module casca_run
   use casca_error, only: error_t
   use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
-  use casca_scene, only: build_model, initial_state, tracked_nodes, contact_pairs, scene_obstacles
+  use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
   use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
@@ -17,7 +17,7 @@ module casca_run
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
                           output_flush, output_release
   use casca_vtu_writer, only: field_t, field
-  use casca_contact, only: contact_t, contact_init
+  use casca_contact, only: contact_t
   use casca_contact_active_set, only: contact_update
   use casca_contact_rows, only: contact_force_total, contact_nodal_fields
   use casca_contact_probes, only: contact_penetration, contact_signed_distance
@@ -68,13 +68,11 @@ contains
     subroutine check_overlap()
       type(contact_t) :: probe
       real(dp), allocatable :: q(:)
-      integer, allocatable :: pairs(:, :)
       integer :: added, k, worst
+      logical :: found
       character(len=512) :: msg
-      allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
-      if (size(pairs, 2) == 0) return
-      call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
-                        deck%contact%surface == 'faces', probe)
+      call scene_contact(deck, model, probe, found)
+      if (.not. found) return
       allocate (q(model%ndof))
       call reference_state(model, q)
       call contact_update(probe, model, q, .true., added)
@@ -83,7 +81,7 @@ contains
       k = probe%act(worst)%node
       write (msg, '(a,a,a,a,a,i0,a,es10.3,a,i0,a)') 'bodies ''', &
         trim(model%body(model%node_body(k))%name), ''' and ''', &
-        trim(target_name(pairs(2, probe%act(worst)%pair))), ''' overlap at the start: node ', &
+        trim(target_name(probe%pair(2, probe%act(worst)%pair))), ''' overlap at the start: node ', &
         k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, &
         ' m inside (', added, ' nodes in all); move them apart'
       if (probe%faces) msg = trim(msg)//' (contact is between the shell faces: half of each '// &
@@ -98,12 +96,11 @@ contains
       type(pair_gap_t), allocatable :: pg(:)
       character(len=320), allocatable :: lines(:)
       character(len=64), allocatable :: bnames(:), onames(:)
-      integer, allocatable :: pairs(:, :)
       integer :: k, n
-      allocate (pairs, source=contact_pairs(deck, model))
-      if (size(pairs, 2) == 0 .or. .not. is_root()) return
-      call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
-                        deck%contact%surface == 'faces', probe)
+      logical :: found
+      if (.not. is_root()) return
+      call scene_contact(deck, model, probe, found)
+      if (.not. found) return
       call initial_state(deck, model, st0)
       pg = pair_gaps(probe, model, reshape(st0%q([((dof(n, k), k=1, 3), n=1, model%nnode)]), &
                      [3, model%nnode]), reshape(st0%q([((dof(n, k), k=4, 6), n=1, model%nnode)]), &
@@ -352,17 +349,9 @@ contains
     end function split_bodies
 
     subroutine setup_contact()
-      integer, allocatable :: pairs(:, :)
-      allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
-      use_contact = size(pairs, 2) > 0
+      call scene_contact(deck, model, contact, use_contact)
       ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
-      if (use_contact) then
-        call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
-                          deck%contact%surface == 'faces', contact)
-        if (deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
-        contact%nodal_normal = deck%contact%normal == 'nodal'
-        call set_friction()
-      end if
+      if (use_contact .and. deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
     end subroutine setup_contact
 
     !> the energy balance's terms that the scene has: friction's, moving obstacles'
@@ -381,38 +370,6 @@ contains
       moving_obstacles = use_contact .and. any([(any(deck%obstacles(k)%velocity /= 0), &
                                                  k=1, size(deck%obstacles))])
     end function moving_obstacles
-
-    !> each pair's coefficients: its obstacle's, or its own in &contact (the listed pair of
-    !> the same two bodies, either way round), else &contact's; static defaults to dynamic
-    subroutine set_friction()
-      integer :: p, t, j
-      real(dp) :: d, st_
-      do p = 1, contact%npairs
-        d = deck%contact%friction; st_ = deck%contact%static_friction
-        t = contact%pair(2, p)
-        if (t < 0) then
-          if (deck%obstacles(-t)%friction /= unset) d = deck%obstacles(-t)%friction
-          if (deck%obstacles(-t)%static_friction /= unset) st_ = deck%obstacles(-t)%static_friction
-        else
-          do j = 1, deck%contact%npairs
-            if (.not. same_bodies(j, contact%pair(1, p), t)) cycle
-            if (deck%contact%pair_friction(j) /= unset) d = deck%contact%pair_friction(j)
-            if (deck%contact%pair_static_friction(j) /= unset) st_ = deck%contact%pair_static_friction(j)
-          end do
-        end if
-        contact%mu_d(p) = d
-        contact%mu_s(p) = merge(st_, d, st_ /= unset)
-      end do
-    end subroutine set_friction
-
-    !> listed pair j is bodies a and b, either way round
-    logical function same_bodies(j, a, b)
-      integer, intent(in) :: j, a, b
-      associate (names => deck%contact%pairs(:, j))
-        same_bodies = (names(1) == model%body(a)%name .and. names(2) == model%body(b)%name) .or. &
-                      (names(2) == model%body(a)%name .and. names(1) == model%body(b)%name)
-      end associate
-    end function same_bodies
 
     subroutine history_row(newton)
       integer, intent(in) :: newton

@@ -6,15 +6,17 @@ module casca_scene
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_ring, mesh_sphere, mesh_plate
   use casca_gmsh_io, only: read_gmsh
-  use casca_deck, only: deck_t, add_problem, deck_file
+  use casca_deck, only: deck_t, add_problem, deck_file, unset
   use casca_sanity, only: parse_fix
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
   use casca_newmark, only: state_t
   use casca_vectors, only: cross
   use casca_obstacle, only: obstacle_t
+  use casca_contact, only: contact_t, contact_init
   implicit none
   private
-  public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles
+  public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles, &
+            scene_contact
 
 contains
 
@@ -231,6 +233,50 @@ contains
       body_index = findloc([(model%body(i)%name == name, i=1, model%nbody)], .true., dim=1)
     end function body_index
   end function contact_pairs
+
+  !> The contact problem of the deck (contact_pairs), or none: its pairs and obstacles,
+  !> tolerance, surfaces and normals, and each pair's coefficients of friction (its
+  !> obstacle's, or its own in &contact: the listed pair of the same two bodies, either way
+  !> round; else &contact's; static defaults to dynamic). found: it has a pair.
+  subroutine scene_contact(deck, model, c, found)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    type(contact_t), intent(out) :: c
+    logical, intent(out) :: found
+    integer, allocatable :: pairs(:, :)
+    integer :: p, t, j
+    real(dp) :: d, st
+    allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
+    found = size(pairs, 2) > 0
+    if (.not. found) return
+    call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
+                      deck%contact%surface == 'faces', c)
+    c%nodal_normal = deck%contact%normal == 'nodal'
+    do p = 1, c%npairs
+      d = deck%contact%friction; st = deck%contact%static_friction
+      t = c%pair(2, p)
+      if (t < 0) then
+        if (deck%obstacles(-t)%friction /= unset) d = deck%obstacles(-t)%friction
+        if (deck%obstacles(-t)%static_friction /= unset) st = deck%obstacles(-t)%static_friction
+      else
+        do j = 1, deck%contact%npairs
+          if (.not. same_bodies(deck%contact%pairs(:, j), c%pair(1, p), t)) cycle
+          if (deck%contact%pair_friction(j) /= unset) d = deck%contact%pair_friction(j)
+          if (deck%contact%pair_static_friction(j) /= unset) st = deck%contact%pair_static_friction(j)
+        end do
+      end if
+      c%mu_d(p) = d
+      c%mu_s(p) = merge(st, d, st /= unset)
+    end do
+  contains
+    !> the two names are bodies a and b, either way round
+    logical function same_bodies(names, a, b)
+      character(len=*), intent(in) :: names(2)
+      integer, intent(in) :: a, b
+      same_bodies = (names(1) == model%body(a)%name .and. names(2) == model%body(b)%name) .or. &
+                    (names(2) == model%body(a)%name .and. names(1) == model%body(b)%name)
+    end function same_bodies
+  end subroutine scene_contact
 
   !> The deck's rigid obstacles, their normal and axis made unit vectors.
   function scene_obstacles(deck) result(obs)
