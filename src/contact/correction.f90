@@ -19,7 +19,7 @@ module casca_contact_correction
   use casca_shell_element, only: ndof_node
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_projection, only: constraint_row, max_row
-  use casca_contact_rows, only: constraint_kinds
+  use casca_contact_rows, only: constraint_nkinds
   use casca_mass_solver, only: mass_solver_t
   use casca_lapack, only: dpotrf, dpotrs
   implicit none
@@ -127,13 +127,14 @@ contains
   subroutine row_list(cons, rk, rkind)
     type(constraint_t), intent(in) :: cons(:)
     integer, allocatable, intent(out) :: rk(:), rkind(:)
-    integer :: k
-    integer, allocatable :: kinds(:)
-    allocate (rk(0), rkind(0))
+    integer :: k, kind, r
+    r = sum([(constraint_nkinds(cons(k)), k=1, size(cons))])
+    allocate (rk(r), rkind(r))
+    r = 0
     do k = 1, size(cons)
-      kinds = constraint_kinds(cons(k))
-      rk = [rk, spread(k, 1, size(kinds))]
-      rkind = [rkind, kinds]
+      do kind = 0, constraint_nkinds(cons(k)) - 1
+        r = r + 1; rk(r) = k; rkind(r) = kind
+      end do
     end do
   end subroutine row_list
 

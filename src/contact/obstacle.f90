@@ -6,9 +6,7 @@ module casca_obstacle
   use casca_kinds, only: dp
   implicit none
   private
-  public :: obstacle_t, obstacle_point, obstacle_kinds
-
-  character(len=*), parameter :: obstacle_kinds(3) = [character(len=8) :: 'plane', 'sphere', 'cylinder']
+  public :: obstacle_t, obstacle_point
 
   type :: obstacle_t
     character(len=64) :: name = ''

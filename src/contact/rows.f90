@@ -10,36 +10,34 @@ module casca_contact_rows
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
-  public :: constraint_kinds, slip_force, obstacle_power
+  public :: constraint_nkinds, slip_force, obstacle_power
 
 contains
 
-  !> The row kinds of a constraint: 0 (normal), and 1, 2 (stick) when it sticks
-  pure function constraint_kinds(a) result(kinds)
+  !> How many rows a constraint has: kinds 0 (normal) to this less one (1, 2: stick)
+  pure integer function constraint_nkinds(a)
     type(constraint_t), intent(in) :: a
-    integer, allocatable :: kinds(:)
-    if (a%grip == stick) then
-      kinds = [0, 1, 2]
-    else
-      kinds = [0]
-    end if
-  end function constraint_kinds
+    constraint_nkinds = merge(3, 1, a%grip == stick)
+  end function constraint_nkinds
 
   !> Number of rows of the active set
   pure integer function contact_nrows(c)
     type(contact_t), intent(in) :: c
-    contact_nrows = c%nact + 2*count(c%act(1:c%nact)%grip == stick)
+    integer :: k
+    contact_nrows = sum([(constraint_nkinds(c%act(k)), k=1, c%nact)])
   end function contact_nrows
 
   !> The multipliers of every row, in row order
   pure function contact_multipliers(c) result(lam)
     type(contact_t), intent(in) :: c
     real(dp), allocatable :: lam(:)
-    integer :: k
-    allocate (lam(0))
+    integer :: k, r
+    allocate (lam(contact_nrows(c)))
+    r = 0
     do k = 1, c%nact
-      lam = [lam, c%act(k)%lambda]
-      if (c%act(k)%grip == stick) lam = [lam, c%act(k)%lt]
+      r = r + 1; lam(r) = c%act(k)%lambda
+      if (c%act(k)%grip /= stick) cycle
+      lam(r + 1:r + 2) = c%act(k)%lt; r = r + 2
     end do
   end function contact_multipliers
 
@@ -65,26 +63,24 @@ contains
     integer, intent(in) :: eq(:), neq
     integer, allocatable, intent(out) :: irn(:), jcn(:), key(:, :)
     real(dp), allocatable, intent(out) :: val(:), gap(:), fval(:)
-    integer :: k, j, m, nd, d(max_row), r, i, nr, ns
-    integer, allocatable :: kinds(:)
+    integer :: k, j, m, nd, d(max_row), r, kind, nr, ns
     real(dp) :: v(max_row), vs(max_row), mu
     nr = contact_nrows(c)
     allocate (irn((max_row + 1)*nr), jcn((max_row + 1)*nr), val((max_row + 1)*nr), gap(nr), key(2, nr), &
               fval((max_row + 1)*nr))
     m = 0; r = 0
     do k = 1, c%nact
-      kinds = constraint_kinds(c%act(k))
-      do i = 1, size(kinds)
+      do kind = 0, constraint_nkinds(c%act(k)) - 1
         r = r + 1
-        if (kinds(i) == 0) then
+        if (kind == 0) then
           gap(r) = c%act(k)%gap
         else
-          gap(r) = c%act(k)%gt(kinds(i))
+          gap(r) = c%act(k)%gt(kind)
         end if
-        key(:, r) = [4*c%act(k)%node + kinds(i), c%act(k)%elem]
-        call constraint_row(c%act(k), model, d, v, nd, kinds(i))
+        key(:, r) = [4*c%act(k)%node + kind, c%act(k)%elem]
+        call constraint_row(c%act(k), model, d, v, nd, kind)
         mu = 0; ns = 0
-        if (kinds(i) == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
+        if (kind == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
           mu = c%mu_d(c%act(k)%pair); key(1, r) = 4*c%act(k)%node + 3
           call constraint_row(c%act(k), model, d, vs, ns, 3)   ! (the same points first)
         end if
