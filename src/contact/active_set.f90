@@ -4,7 +4,7 @@ module casca_contact_active_set
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
-  use casca_contact, only: contact_t, constraint_t, search_radius, pair_offset, stick
+  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry
   use casca_contact_friction, only: friction_on
   implicit none
@@ -64,7 +64,7 @@ contains
       bi = c%pair(1, ip); bt = c%pair(2, ip)
       boxi = body_box(model, x, bi)
       if (bt <= 0) then   ! an obstacle: every node, by its distance
-        reach = 1.25_dp*pair_offset(c, model, bi, bt) + c%tol
+        reach = search_radius(c, model, bi, bt)
         do n = model%body(bi)%node_first, model%body(bi)%node_last
           call obstacle_point(c%obstacle(-bt), c%time, x(:, n), nrm, d)
           if (d > reach) cycle
@@ -82,7 +82,7 @@ contains
       ! constraint's own gap decides (else a node released with zero gap would be taken
       ! again at once where the chord lies outside the surface). A cubic arc bulges from
       ! its chord e by kappa e^2 / 8, below a quarter of depth = e / 2 while kappa e < 1
-      reach = 1.25_dp*pair_offset(c, model, bi, bt) + 0.25_dp*c%geo%depth(bt)
+      reach = face_reach(c, model, bi, bt) + 0.25_dp*c%geo%depth(bt)
       do n = model%body(bi)%node_first, model%body(bi)%node_last
         if (any(x(:, n) > boxt(:, 2) + r) .or. any(x(:, n) < boxt(:, 1) - r)) cycle
         if (is_active(n, ip)) cycle

@@ -15,7 +15,7 @@ module casca_contact
   use casca_obstacle, only: obstacle_t
   implicit none
   private
-  public :: contact_t, constraint_t, target_geometry_t, contact_init, pair_offset, search_radius
+  public :: contact_t, constraint_t, target_geometry_t, contact_init, face_reach, search_radius
 
   type :: constraint_t
     integer :: node = 0, pair = 0
@@ -160,24 +160,30 @@ contains
     end associate
   end subroutine contact_init
 
-  !> The faces' distance between the mid-surfaces of impactor bi and target bt (a body, or
-  !> <= 0: an obstacle) in the initial state: half of each thickness; 0 between mid-surfaces
-  pure real(dp) function pair_offset(c, model, bi, bt)
+  !> How far apart the mid-surfaces of impactor bi and target bt (a body, or <= 0: an
+  !> obstacle) can be when their faces touch: half of each thickness, with room for the
+  !> fibres' stretch (0 between mid-surfaces)
+  pure real(dp) function face_reach(c, model, bi, bt)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     integer, intent(in) :: bi, bt
-    pair_offset = 0
+    face_reach = 0
     if (.not. c%faces) return
-    pair_offset = 0.5_dp*model%body(bi)%thickness
-    if (bt > 0) pair_offset = pair_offset + 0.5_dp*model%body(bt)%thickness
-  end function pair_offset
+    face_reach = 0.5_dp*model%body(bi)%thickness
+    if (bt > 0) face_reach = face_reach + 0.5_dp*model%body(bt)%thickness
+    face_reach = 1.25_dp*face_reach
+  end function face_reach
 
-  !> How far from the target's mid-surface (bt > 0) a node of bi is looked for: the faces'
-  !> offset (with room for the fibre's stretch) and the band below the surface
+  !> How far from the target's mid-surface a node of bi is looked for: the faces' reach and,
+  !> for a body, the band below its surface; for an obstacle, the contact tolerance
   pure real(dp) function search_radius(c, model, bi, bt)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     integer, intent(in) :: bi, bt
-    search_radius = 1.25_dp*pair_offset(c, model, bi, bt) + c%geo%depth(bt)
+    if (bt > 0) then
+      search_radius = face_reach(c, model, bi, bt) + c%geo%depth(bt)
+    else
+      search_radius = face_reach(c, model, bi, bt) + c%tol
+    end if
   end function search_radius
 end module casca_contact

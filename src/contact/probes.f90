@@ -3,7 +3,7 @@
 module casca_contact_probes
   use casca_kinds, only: dp
   use casca_model, only: model_t
-  use casca_contact, only: contact_t, search_radius, pair_offset
+  use casca_contact, only: contact_t, search_radius
   use casca_contact_active_set, only: contact_update
   implicit none
   private
@@ -45,11 +45,7 @@ contains
     sd = 0
     do ip = 1, c%npairs
       b = c%pair(1, ip)
-      if (c%pair(2, ip) > 0) then
-        sd(model%body(b)%node_first:model%body(b)%node_last) = search_radius(c, model, b, c%pair(2, ip))
-      else   ! (the reach of an obstacle's detection)
-        sd(model%body(b)%node_first:model%body(b)%node_last) = 1.25_dp*pair_offset(c, model, b, 0) + c%tol
-      end if
+      sd(model%body(b)%node_first:model%body(b)%node_last) = search_radius(c, model, b, c%pair(2, ip))
     end do
     ! every node within reach, penetrating or not: a probe that takes any gap
     call new_probe(c, -huge(1._dp), probe)

@@ -6,7 +6,7 @@
 module casca_free_flight
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t, pair_offset
+  use casca_contact, only: contact_t, face_reach
   use casca_obstacle, only: obstacle_point
   implicit none
   private
@@ -56,11 +56,11 @@ contains
       i = contact%pair(1, k); j = contact%pair(2, k)
       if (j > 0) then
         if (.not. (idle(i) .or. idle(j))) cycle
-        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + 1.25_dp*pair_offset(contact, model, i, j)
+        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + face_reach(contact, model, i, j)
       else
         if (.not. idle(i)) cycle
         reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%tol + &
-                1.25_dp*pair_offset(contact, model, i, j)
+                face_reach(contact, model, i, j)
       end if
       do n = model%body(i)%node_first, model%body(i)%node_last
         x = q(dof(n, 1):dof(n, 3))
