@@ -23,7 +23,7 @@ module casca_contact_projection
   use casca_contact, only: contact_t, constraint_t, search_radius
   implicit none
   private
-  public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row
+  public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face
 
   integer, parameter, public :: max_row = 66   !< 11 nodes x (Y, G)
 

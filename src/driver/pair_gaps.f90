@@ -22,6 +22,7 @@ module casca_pair_gaps
   use casca_obstacle, only: obstacle_point
   use casca_closest_point, only: closest_point_triangle
   use casca_contact, only: contact_t
+  use casca_contact_projection, only: face
   implicit none
   private
   public :: pair_gap_t, pair_gaps, pair_gap_lines
@@ -55,7 +56,7 @@ contains
               ! (a node held in place is never constrained: active_set.f90)
               if (all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
               call obstacle_point(ob, 0._dp, x(:, n), nrm, d)
-              gap = d - face(bi, g(:, n), nrm)
+              gap = d - face_along(bi, g(:, n), nrm)
               if (gap < r%gap) then
                 r%gap = gap; r%node = n
                 r%speed = -dot_product(v(:, n) - ob%velocity, nrm)
@@ -89,7 +90,7 @@ contains
               if (best_tri == 0) cycle
               u = x(:, n) - best_q
               if (norm2(u) > 0) u = u/norm2(u)
-              gap = best - face(bi, g(:, n), u) - face(bt, matmul(g(:, s%tri(:, best_tri)), best_bary), u)
+              gap = best - face_along(bi, g(:, n), u) - face_along(bt, matmul(g(:, s%tri(:, best_tri)), best_bary), u)
               if (gap >= r%gap) cycle
               r%gap = gap; r%node = n
               vt = matmul(v(:, s%tri(:, best_tri)), best_bary)
@@ -106,17 +107,18 @@ contains
       end associate
     end do
   contains
-    !> half of body b's thickness along the fibre gf towards u, as projection.f90's face():
-    !> none edge-on (fibre more than 60 degrees from u) and between mid-surfaces
-    real(dp) function face(b, gf, u)
+    !> body b's face along u, as a new constraint chooses it (projection.f90); none between
+    !> mid-surfaces
+    real(dp) function face_along(b, gf, u)
       integer, intent(in) :: b
       real(dp), intent(in) :: gf(3), u(3)
-      real(dp) :: k
-      face = 0
+      integer :: s
+      real(dp) :: w
+      face_along = 0
       if (.not. c%faces) return
-      k = abs(dot_product(gf, u))
-      if (k >= 0.5_dp*norm2(gf)) face = 0.5_dp*model%body(b)%thickness*k
-    end function face
+      s = 0
+      call face(model%body(b)%thickness, gf, u, s, face_along, w)
+    end function face_along
 
     real(dp) function max_speed(b1, b2)
       integer, intent(in) :: b1, b2
