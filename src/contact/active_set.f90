@@ -6,10 +6,10 @@ module casca_contact_active_set
   use casca_obstacle, only: obstacle_point
   use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry
-  use casca_contact_friction, only: friction_on
+  use casca_contact_friction, only: friction_on, friction_update
   implicit none
   private
-  public :: contact_update, contact_release
+  public :: contact_update, contact_release, contact_settle, contact_solve_start
 
 contains
 
@@ -156,6 +156,30 @@ contains
       c%act(c%nact) = con
     end subroutine push
   end subroutine contact_update
+
+  !> A new solve of a step: no active-set change yet
+  subroutine contact_solve_start(c)
+    type(contact_t), intent(inout) :: c
+    c%changes = 0
+    c%act(1:c%nact)%flips = 0
+  end subroutine contact_solve_start
+
+  !> Where Newton has converged for the set: stick/slip changes first, else releases and new
+  !> penetrations (which also measures the gaps at q). A trial stick's multiplier may be
+  !> tensile only because it stopped the sliding: released first, the node would be taken
+  !> again, step after step. changed: how many changes.
+  subroutine contact_settle(c, model, q, changed)
+    type(contact_t), intent(inout) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    integer, intent(out) :: changed
+    integer :: released, added
+    call friction_update(c, changed)
+    if (changed > 0) return
+    call contact_release(c, released)
+    call contact_update(c, model, q, .true., added, reproject=.false.)
+    changed = released + added
+  end subroutine contact_settle
 
   !> Release the constraints whose multiplier is tensile (lambda > 0); how many were released.
   subroutine contact_release(c, released)

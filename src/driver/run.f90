@@ -198,24 +198,7 @@ contains
       if (failed('restart')) return
       restart_step = st%step
     end if
-    block   ! the history's per-body and per-pair columns are named after these
-      character(len=64), allocatable :: body_names(:)   ! (the deck's longest name)
-      character(len=:), allocatable :: pair_names(:)
-      logical :: friction
-      body_names = [character(len=64) :: (model%body(k)%name, k=1, model%nbody)]
-      friction = .false.
-      if (use_contact) friction = deck%run%analysis /= 'static' .and. (any(contact%mu_d > 0) .or. &
-                                                                      any(contact%mu_s > 0))
-      if (use_contact) then
-        ! targets -k are obstacles: names from -size(obstacles) up, then the bodies
-        call pair_labels(contact%pair, [character(len=64) :: (deck%obstacles(-k)%name, &
-                         k=-size(deck%obstacles), -1), '-', body_names], -size(deck%obstacles), pair_names)
-      else
-        allocate (character(len=1) :: pair_names(0))
-      end if
-      call output_open(out, dir, tracked, labels, body_names, pair_names, friction, moving_obstacles(), &
-                       restart_step, st%t, err)
-    end block
+    call open_history()
     if (failed('output')) return
 
     t0 = wall_time(); t_start = st%t
@@ -354,22 +337,23 @@ contains
       if (use_contact .and. deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
     end subroutine setup_contact
 
-    !> the energy balance's terms that the scene has: friction's, moving obstacles'
-    function extra_terms() result(terms)
-      type(energy_term_t), allocatable :: terms(:)
-      allocate (terms(0))
-      if (.not. use_contact) return
-      if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
-                                                               sum(contact%friction_work))]
-      if (moving_obstacles()) &
-        terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
-    end function extra_terms
-
-    logical function moving_obstacles()
-      integer :: k
-      moving_obstacles = use_contact .and. any([(any(deck%obstacles(k)%velocity /= 0), &
-                                                 k=1, size(deck%obstacles))])
-    end function moving_obstacles
+    !> the output folder and files; the history's per-body and per-pair columns are named
+    !> after the bodies and obstacles (targets -k: names from -size(obstacles) up)
+    subroutine open_history()
+      character(len=64), allocatable :: body_names(:)   ! (the deck's longest name)
+      character(len=:), allocatable :: pair_names(:)
+      logical :: friction
+      body_names = [character(len=64) :: (model%body(k)%name, k=1, model%nbody)]
+      friction = .false.
+      allocate (character(len=1) :: pair_names(0))
+      if (use_contact) then
+        friction = deck%run%analysis /= 'static' .and. (any(contact%mu_d > 0) .or. any(contact%mu_s > 0))
+        call pair_labels(contact%pair, [character(len=64) :: (deck%obstacles(-k)%name, &
+                         k=-size(deck%obstacles), -1), '-', body_names], -size(deck%obstacles), pair_names)
+      end if
+      call output_open(out, dir, tracked, labels, body_names, pair_names, friction, &
+                       moving_obstacles(deck, use_contact), restart_step, st%t, err)
+    end subroutine open_history
 
     subroutine history_row(newton)
       integer, intent(in) :: newton
@@ -477,7 +461,7 @@ contains
         if (deck%run%analysis /= 'static' .and. restart_step < 0) then
           print '(a)', balance_summary(bal0, bal, model%length, any(model%fixed) .or. &
                                        any(fext /= 0) .or. any(fgrav /= 0) .or. size(deck%obstacles) > 0)
-          print '(a)', energy_balance(bal0, bal, extra_terms())
+          print '(a)', energy_balance(bal0, bal, balance_terms(deck, contact, use_contact))
         end if
       end if
     end subroutine finish
@@ -510,4 +494,25 @@ contains
       call finish()
     end subroutine static_run
   end subroutine run_deck
+  !> The energy balance's terms that the scene has: friction's, moving obstacles'
+  function balance_terms(deck, contact, use_contact) result(terms)
+    type(deck_t), intent(in) :: deck
+    type(contact_t), intent(in) :: contact
+    logical, intent(in) :: use_contact
+    type(energy_term_t), allocatable :: terms(:)
+    allocate (terms(0))
+    if (.not. use_contact) return
+    if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
+                                                             sum(contact%friction_work))]
+    if (moving_obstacles(deck, use_contact)) &
+      terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
+  end function balance_terms
+
+  logical function moving_obstacles(deck, use_contact)
+    type(deck_t), intent(in) :: deck
+    logical, intent(in) :: use_contact
+    integer :: k
+    moving_obstacles = use_contact .and. any([(any(deck%obstacles(k)%velocity /= 0), &
+                                               k=1, size(deck%obstacles))])
+  end function moving_obstacles
 end module casca_run

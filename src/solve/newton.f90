@@ -24,10 +24,9 @@ module casca_newton
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
                                  kkt_solve, negative_pivots
   use casca_contact, only: contact_t, constraint_t
-  use casca_contact_active_set, only: contact_update, contact_release
+  use casca_contact_active_set, only: contact_update, contact_settle, contact_solve_start
   use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_nrows, &
                                 contact_multipliers, contact_set_multipliers, contact_max_gap
-  use casca_contact_friction, only: friction_update
   use casca_mpi, only: is_root, sum_all
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve
@@ -99,9 +98,8 @@ contains
     allocate (r(model%ndof), res(model%ndof))
     q_entry = q
     if (present(contact)) then
-      contact%act(1:contact%nact)%flips = 0
+      call contact_solve_start(contact)
       act_entry = contact%act(1:contact%nact)
-      contact%changes = 0
     end if
     ffloor = inertial_floor()
     refresh_next = .false.
@@ -329,24 +327,16 @@ contains
       if (rho < 0.5_dp) small_enough = nrm*rho/(1 - rho) <= opts%tol
     end function small_enough
 
-    !> converged for this set: release tensile multipliers, look for new penetrations (which
-    !> also measures the gaps at the new iterate). True when the set changed; an error when
-    !> it keeps changing.
+    !> converged for this set: stick/slip, releases and new penetrations (contact_settle).
+    !> True when the set changed; an error when it keeps changing.
     logical function set_changed()
-      integer :: released, added, slipped
+      integer :: changed
       set_changed = .false.
       if (.not. present(contact)) return
       call timer_start(t_contact)
-      ! stick/slip first: a trial stick's multiplier may be tensile only because it stopped
-      ! the sliding (the node would then be released and taken again, step after step)
-      released = 0; added = 0
-      call friction_update(contact, slipped)
-      if (slipped == 0) then
-        call contact_release(contact, released)
-        call contact_update(contact, model, q, .true., added, reproject=.false.)
-      end if
+      call contact_settle(contact, model, q, changed)
       call timer_stop(t_contact)
-      set_changed = released > 0 .or. added > 0 .or. slipped > 0
+      set_changed = changed > 0
       if (set_changed .and. contact%changes >= max_set_changes) &
         call fatal_error(err, 'the contact active set did not settle')
     end function set_changed
