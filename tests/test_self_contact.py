@@ -24,6 +24,17 @@ self       a steel ring (R 0.1, h 10 mm, width 20 mm, 24 elements) pressed flat 
            thickness strain under the planes' force, about 1 MN on 2e-3 m^2 of steel, sigma/E ~
            0.5%; measured mid-surfaces 0.9958 h apart).
            (A ring thrown at 60 m/s flat onto one plane, h 3 mm, 2 ms, never closed its inner faces.)
+fold       a long strip (h 2 mm, width 20 mm, steel with nu 0, 60 x 2 elements) folded in two: a
+           hairpin of two straight legs a = 10 mm either side of its bend (a half circle of radius
+           a), clamped at the bend's apex; static, a force F = 25 N at the tip of the shorter leg
+           (L = 0.2 m from the bend) presses it onto the longer leg (self-contact, faces), in 20
+           load steps. Each leg is a curved cantilever from the apex with the same compliance c
+           at x = L (Castigliano, bending only: c = (L^3/3 + a (pi L^2/2 + 2 a L + pi a^2/4))/EI,
+           EI = E h^3 b / 12), and the faces close the gap g = 2 a - h: the contact force is
+           (F - g / c) / 2 = 4.945 N. Asserted: self-contact at the last load step, its force
+           within 2% of that (the rest is the legs' rotation, about 0.1 rad, which the linear
+           answer leaves out), no tensile multiplier, and the loaded tip's mid-surface at least
+           0.9 h above the nearest node of the other leg (the faces do not pass each other).
 """
 import math
 import os
@@ -123,4 +134,41 @@ if out is not None:
     mid = np.abs(x[:, 0]) < 0.05
     gap = x[mid & (x[:, 1] > 0), 1].min() - x[mid & (x[:, 1] < 0), 1].max()
     ck.le("self: the walls' mid-surfaces near the middle, h minus their distance, over h", (hs - gap) / hs, 0.01)
+
+# --- self-contact: a strip folded in two, pressed onto itself by a load at one tip
+L, a, hf, b, F = 0.2, 0.01, 0.002, 0.02, 25.0
+L1 = (3 * math.pi * a + 33 * L) / 27   # (the longer leg: the apex falls on a node of 60 elements)
+flat, hairpin = os.path.join(work, "flat.msh"), os.path.join(work, "hairpin.msh")
+run([casca, "mesh", "strip", "--lx", repr(L1 + math.pi * a + L), "--ly", repr(b), "--nx", "60", "--ny", "2",
+     "-o", flat])
+lines = open(flat).read().split("\n")   # (bent: x along the strip becomes leg, half circle, leg)
+first = lines.index("$Nodes") + 3 + int(lines[lines.index("$Nodes") + 2].split()[3])
+for k in range(first, first + int(lines[lines.index("$Nodes") + 2].split()[3])):
+    x, y, _ = map(float, lines[k].split())
+    if x <= L1:
+        px, py = L1 - x, -a
+    elif x <= L1 + math.pi * a:
+        px, py = -a * math.sin((x - L1) / a), -a * math.cos((x - L1) / a)
+    else:
+        px, py = x - L1 - math.pi * a, a
+    lines[k] = "%.16e %.16e %.16e" % (px, py, y)
+open(hairpin, "w").write("\n".join(lines))
+out = go("fold", f"""&run analysis = 'static', load_steps = 20 /
+&output vtu = .false., plots = .false., track = {L}, {a}, 0.0, {L}, {-a}, 0.0 /
+&body name = 'u', mesh = 'file', file = '{hairpin}', young = 210e9, poisson = 0.0, density = 7700,
+  thickness = {hf} /
+&restraint body = 'u', fix = 'all', box_min = {-a - 1e-4}, -1e-6, -1.0, box_max = {-a + 1e-4}, 1e-6, 1.0 /
+&load body = 'u', box_min = {L - 1e-4}, {a - 1e-4}, -1.0, box_max = {L + 1e-4}, {a + 1e-4}, 1.0,
+  force = 0.0, {-F}, 0.0 /
+&contact pairs = 'u', 'u' /
+""")
+if out is not None:
+    hist = history(out)
+    EI = 210e9 * hf ** 3 * b / 12
+    c = (L ** 3 / 3 + a * (math.pi * L ** 2 / 2 + 2 * a * L + math.pi * a ** 2 / 4)) / EI
+    ck.record("fold: self-contact at the last load step", hist["contacts_u_u"][-1] > 0)
+    ck.close("fold: contact force [N] vs (F - g/c)/2", hist["fcontact_u_u"][-1], (F - (2 * a - hf) / c) / 2, 0.02)
+    ck.le("fold: most tensile multiplier [N]", hist["lambda_max"].max(), 0.0)
+    ck.le("fold: h minus the loaded tip's distance above the other leg, over h",
+          (hf - (hist["p1_y"][-1] - hist["p2_y"][-1])) / hf, 0.1)
 ck.finish()

@@ -76,6 +76,9 @@ module casca_contact
     real(dp) :: dt = 0
     real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
     real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
+    ! per pair: the impulse on the impactor so far, as the integrator applied it, and the
+    ! force the start acceleration of the next step carries times 1 - gamma [N s, N]
+    real(dp), allocatable :: impulse(:, :), carry(:, :)
     type(target_geometry_t) :: geo
     ! the active set
     integer :: nact = 0
@@ -104,6 +107,8 @@ contains
     c%faces = faces
     allocate (c%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
     c%mu_d = 0; c%mu_s = 0; c%friction_work = 0
+    allocate (c%impulse(3, c%npairs), c%carry(3, c%npairs))
+    c%impulse = 0; c%carry = 0
     associate (g => c%geo)
       allocate (g%surf(model%nbody), g%grid(c%npairs), g%grid_ok(c%npairs), g%depth(model%nbody), &
                 g%skip(model%nbody))

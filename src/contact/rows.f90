@@ -10,7 +10,7 @@ module casca_contact_rows
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
-  public :: constraint_nkinds, slip_force, obstacle_power
+  public :: constraint_nkinds, slip_force, add_step_impulse
 
 contains
 
@@ -146,17 +146,47 @@ contains
     end do
   end function contact_max_gap
 
-  !> Power of the obstacles' forces on the bodies (moving obstacles do work)
-  pure real(dp) function obstacle_power(c)
-    type(contact_t), intent(in) :: c
-    integer :: k, t
-    obstacle_power = 0
-    do k = 1, c%nact
-      t = c%pair(2, c%act(k)%pair)
-      if (t > 0) cycle
-      obstacle_power = obstacle_power + dot_product(node_force(c, c%act(k)), c%obstacle(-t)%velocity)
+  !> After an accepted step of length dt (Newmark's gamma g): add each pair's impulse on its
+  !> impactor as the integrator applied it, and the moving obstacles' work from it. The
+  !> step changes the momentum by dt ((1 - g) F_start + g F_end) + C^T nu: F_start the
+  !> forces the start acceleration carries (the last step's end forces with their
+  !> acceleration corrections mu, c%carry), less the normal force of the constraints
+  !> released taken out of it (newmark.f90); nu the velocity correction's impulses, in
+  !> row order. (dt F_end summed over the steps is off by Newton's tolerance; this is exact.)
+  subroutine add_step_impulse(c, dt, g, released, nu)
+    type(contact_t), intent(inout) :: c
+    real(dp), intent(in) :: dt, g
+    type(constraint_t), intent(in) :: released(:)
+    real(dp), intent(in) :: nu(:)
+    real(dp) :: j(3, c%npairs), f(3)
+    integer :: k, r, t
+    j = dt*c%carry
+    do k = 1, size(released)
+      associate (a => released(k))
+        j(:, a%pair) = j(:, a%pair) - dt*(1 - g)*(a%mu - a%lambda)*a%n
+      end associate
     end do
-  end function obstacle_power
+    c%carry = 0
+    r = 0
+    do k = 1, c%nact
+      associate (a => c%act(k))
+        f = node_force(c, a)
+        j(:, a%pair) = j(:, a%pair) + dt*g*f + nu(r + 1)*a%n
+        f = f + a%mu*a%n
+        if (a%grip == stick) then
+          j(:, a%pair) = j(:, a%pair) + nu(r + 2)*a%t(:, 1) + nu(r + 3)*a%t(:, 2)
+          f = f + a%mut(1)*a%t(:, 1) + a%mut(2)*a%t(:, 2)
+        end if
+        c%carry(:, a%pair) = c%carry(:, a%pair) + (1 - g)*f
+        r = r + constraint_nkinds(a)
+      end associate
+    end do
+    c%impulse = c%impulse + j
+    do k = 1, c%npairs
+      t = c%pair(2, k)
+      if (t <= 0) c%obstacle_work = c%obstacle_work + dot_product(j(:, k), c%obstacle(-t)%velocity)
+    end do
+  end subroutine add_step_impulse
 
   !> The contact force on the constraint's node: normal and friction
   pure function node_force(c, a) result(f)

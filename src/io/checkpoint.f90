@@ -82,14 +82,16 @@ contains
       ! (newmark.f90): chosen again at the restart they made another run (two rings, the
       ! trapezoidal rule: kinetic energy 0.03% off in that step, 14% later). With friction,
       ! the stick/slip state, the stick multipliers and their corrections, the slip
-      ! direction; last the work summed so far (friction per pair, moving obstacles).
+      ! direction; then the work summed so far (friction per pair, moving obstacles); last
+      ! per pair the impulse so far and the start force of the next step (rows.f90).
       call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, &
                             [level, nact, (contact%act(k)%node, contact%act(k)%pair, contact%act(k)%elem, &
                                            contact%act(k)%side, contact%act(k)%face, contact%act(k)%grip, &
                                            k=1, nact)], &
                             [contact%act(1:nact)%lambda, contact%act(1:nact)%mu, &
                              (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
-                              k=1, nact), contact%friction_work, contact%obstacle_work], err, &
+                              k=1, nact), contact%friction_work, contact%obstacle_work, &
+                             contact%impulse, contact%carry], err, &
                             model_fingerprint(model))
     else
       call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, [level, 0], &
@@ -144,15 +146,17 @@ contains
       end if
     end if
     ! 7 integers (node, pair, elem, side, faces, grip) and 2 + 9 reals (lambda, mu; xi, lt,
-    ! mut, s) per constraint, then the works (npairs + 1); a checkpoint of casca before these
-    ! were kept has 2 and 1 (node, pair; lambda): it is read, point, side and faces chosen
-    ! again at the restart, mu taken as 0, the works as 0
+    ! mut, s) per constraint, then the works (npairs + 1) and the impulses (6 npairs, absent
+    ! from earlier checkpoints: taken as 0); a checkpoint of casca before these were kept has
+    ! 2 and 1 (node, pair; lambda): it is read, point, side and faces chosen again at the
+    ! restart, mu taken as 0, the works as 0
     per = 7
     if (bad == '' .and. present(contact)) then
       if (size(ints) == 2 + 2*int(nact, int64) .and. size(reals) == nact) then
         per = 2
       else if (size(ints) /= 2 + 7*int(nact, int64) .or. &
-               size(reals) /= 11*int(nact, int64) + contact%npairs + 1) then
+               (size(reals) /= 11*int(nact, int64) + contact%npairs + 1 .and. &
+                size(reals) /= 11*int(nact, int64) + 7*contact%npairs + 1)) then
         bad = 'its contact count '//itoa(nact)//' does not match its contact data'
       end if
       if (bad == '' .and. .not. all(ieee_is_finite(reals))) bad = 'its contact forces are not finite'
@@ -198,6 +202,12 @@ contains
     if (per == 7) then
       contact%friction_work = reals(11*nact + 1:11*nact + contact%npairs)
       contact%obstacle_work = reals(11*nact + contact%npairs + 1)
+      if (size(reals) > 11*nact + contact%npairs + 1) then
+        associate (at => 11*nact + contact%npairs + 1, np => contact%npairs)
+          contact%impulse = reshape(reals(at + 1:at + 3*np), [3, np])
+          contact%carry = reshape(reals(at + 3*np + 1:at + 6*np), [3, np])
+        end associate
+      end if
       ! (friction measures slip from the step's start: a dynamic run's constraints only
       ! carry a grip)
       if (any(ints(9:2 + per*nact:per) /= 0)) then

@@ -48,7 +48,7 @@ contains
 
   !> Column names of the history (also the header of history.dat): the fixed ones, the
   !> tracked nodes', then per body (kinetic_B, strain_B) and per contact pair (fcontact_P,
-  !> contacts_P); the per-body and per-pair columns come last, so that the older ones keep
+  !> contacts_P, impulse_P: the magnitude of the impulse on the impactor so far); the per-body and per-pair columns come last, so that the older ones keep
   !> their positions. Names are single words of letters, digits and '_' (anything else in a
   !> body's name becomes '_'), which numpy's genfromtxt(names=True) keeps as they are.
   !> With friction, then ftangent_P per pair and friction_work (dissipated by sliding); with
@@ -73,7 +73,8 @@ contains
     cols = [cols, (word('kinetic_'//trim(bodies(k))), k=1, size(bodies)), &
             (word('strain_'//trim(bodies(k))), k=1, size(bodies)), &
             (word('fcontact_'//trim(pairs(k))), k=1, size(pairs)), &
-            (word('contacts_'//trim(pairs(k))), k=1, size(pairs))]
+            (word('contacts_'//trim(pairs(k))), k=1, size(pairs)), &
+            (word('impulse_'//trim(pairs(k))), k=1, size(pairs))]
     if (friction) cols = [cols, (word('ftangent_'//trim(pairs(k))), k=1, size(pairs)), &
                           word('friction_work')]
     if (moving) cols = [cols, word('obstacle_work')]
@@ -255,14 +256,14 @@ contains
   !> tracked nodes, kinetic and strain energy per body (bal), normal force and active
   !> constraints per contact pair (pair_force, pair_count: as many as output_open's pairs).
   subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, &
-                            lambda_max, gap_max, pair_force, pair_count, err, pair_tangent, friction_work, &
-                            obstacle_work)
+                            lambda_max, gap_max, pair_force, pair_count, pair_impulse, err, pair_tangent, &
+                            friction_work, obstacle_work)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
     integer, intent(in) :: contacts, newton, neg_pivots
     real(dp), intent(in) :: fcontact, penetration, lambda_max, gap_max
-    real(dp), intent(in) :: pair_force(:)
+    real(dp), intent(in) :: pair_force(:), pair_impulse(:)
     integer, intent(in) :: pair_count(:)
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: pair_tangent(:), friction_work, obstacle_work
@@ -278,13 +279,13 @@ contains
       row = [row, st%q(dof(n, 1):dof(n, 3)), st%qd(dof(n, 1):dof(n, 3))]
     end do
     if (size(bal%body_kinetic) /= out%nbody .or. size(pair_force) /= out%npairs .or. &
-        size(pair_count) /= out%npairs) then
+        size(pair_count) /= out%npairs .or. size(pair_impulse) /= out%npairs) then
       call fatal_error(err, 'output_history: '//itoa(size(bal%body_kinetic))//' bodies and '// &
                        itoa(size(pair_force))//' pairs, the history has '//itoa(out%nbody)// &
                        ' and '//itoa(out%npairs))
       return
     end if
-    row = [row, bal%body_kinetic, bal%body_strain, pair_force, real(pair_count, dp)]
+    row = [row, bal%body_kinetic, bal%body_strain, pair_force, real(pair_count, dp), pair_impulse]
     if (out%friction) row = [row, pair_tangent, friction_work]
     if (out%moving) row = [row, obstacle_work]
     write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)

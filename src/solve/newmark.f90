@@ -11,7 +11,7 @@ module casca_newmark
   use casca_contact_correction, only: contact_correction, add_impulses
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
-  use casca_contact_rows, only: obstacle_power
+  use casca_contact_rows, only: add_step_impulse, contact_nrows
   use casca_timers, only: timer_start, timer_stop, t_contact
   implicit none
   private
@@ -50,7 +50,7 @@ contains
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:)
+    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:)
     type(constraint_t), allocatable :: before(:), released(:)
     real(dp) :: b, dt, g
     integer :: k, iters
@@ -62,6 +62,7 @@ contains
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
       contact%x_start = positions(model, st%q); contact%dt = dt   ! (friction's slip)
     end if
+    released = [constraint_t ::]
     call attempt()
     if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
       if (present(contact)) then
@@ -70,7 +71,6 @@ contains
       return
     end if
     if (present(contact) .and. g < 1) then   ! (gamma >= 1: what is left pulls back, dissipates)
-      released = [constraint_t ::]
       do k = 1, size(before)
         if (.not. any(contact%act(1:contact%nact)%node == before(k)%node .and. &
                       contact%act(1:contact%nact)%pair == before(k)%pair)) &
@@ -91,9 +91,9 @@ contains
         rep%iters = rep%iters + iters
       end if
     end if
-    if (present(contact)) then   ! (the end-of-step forces over the step)
+    if (present(contact)) then   ! (before friction turns its slip directions)
+      call add_step_impulse(contact, dt, g, released, nu)
       call friction_step_done(contact)
-      contact%obstacle_work = contact%obstacle_work + dt*obstacle_power(contact)
     end if
     st%q = q; st%qd = qd; st%qdd = qdd
     st%t = st%t + dt
@@ -115,7 +115,9 @@ contains
       qd = rs + g*dt*qdd
       if (present(contact)) then   ! (on failure the state is left as it was)
         call timer_start(t_contact)
-        call contact_correction(ls%mass, contact, model, qd, qdd, err)
+        if (allocated(nu)) deallocate (nu)
+        allocate (nu(contact_nrows(contact)))
+        call contact_correction(ls%mass, contact, model, qd, qdd, err, nu)
         call timer_stop(t_contact)
         if (allocated(err)) return
       end if
