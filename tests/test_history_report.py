@@ -6,7 +6,7 @@ The shipped two-ring deck (examples/two_rings.nml) is run for 4 ms (contact from
 on 1 rank and on 2 ranks (one ring each). It asserts:
   - the header: the columns of the earlier versions first, in their order, then
     kinetic_ring1 kinetic_ring2 strain_ring1 strain_ring2 fcontact_ring1_ring2
-    contacts_ring1_ring2; history.h5 has the same names and values (1e-14 relative);
+    contacts_ring1_ring2 impulse_ring1_ring2; history.h5 has the same names and values (1e-14 relative);
   - on every row: kinetic_ring1 + kinetic_ring2 = kinetic and strain_ring1 + strain_ring2 =
     strain to 1e-12 relative (the totals are the sums; the margin is the 16 printed digits);
     with the one pair, contacts_ring1_ring2 = contacts exactly and fcontact_ring1_ring2 =
@@ -22,7 +22,7 @@ on 1 rank and on 2 ranks (one ring each). It asserts:
     and per-pair columns equal the 1-rank run's to 1e-8 of each column's largest value (the
     bound test_scenes uses for the tracked nodes on 1 and 2 ranks);
   - bodies named 'left ring' and 'right-ring': the columns are kinetic_left_ring,
-    kinetic_right_ring, ..., fcontact_left_ring_right_ring (single words of letters, digits
+    kinetic_right_ring, ..., impulse_left_ring_right_ring (single words of letters, digits
     and '_'), and every row has as many numbers as the header has names.
 """
 import math
@@ -43,7 +43,7 @@ OLD = ("t step kinetic strain work total px py pz Lx Ly Lz contacts fcontact new
        "neg_pivots lambda_max gap_max p1_x p1_y p1_z p1_vx p1_vy p1_vz p2_x p2_y p2_z p2_vx p2_vy "
        "p2_vz").split()
 NEW = ("kinetic_ring1 kinetic_ring2 strain_ring1 strain_ring2 fcontact_ring1_ring2 "
-       "contacts_ring1_ring2").split()
+       "contacts_ring1_ring2 impulse_ring1_ring2").split()
 
 deck = deck_variant(os.path.join(examples, "two_rings.nml"), os.path.join(work, "rings4.nml"),
                     t_end="0.004")
@@ -130,7 +130,7 @@ ck.record("bodies 'left ring' and 'right-ring': exit 0", p.returncode == 0,
 if p.returncode == 0:
     head = open(os.path.join(out, "history.dat")).readline().lstrip("#").split()
     want = ("kinetic_left_ring kinetic_right_ring strain_left_ring strain_right_ring "
-            "fcontact_left_ring_right_ring contacts_left_ring_right_ring").split()
+            "fcontact_left_ring_right_ring contacts_left_ring_right_ring impulse_left_ring_right_ring").split()
     ck.record("their columns: %s" % " ".join(want), head[len(OLD):] == want, " ".join(head[len(OLD):]))
     rows = np.atleast_2d(np.loadtxt(os.path.join(out, "history.dat")))
     ck.record("every row has as many numbers as the header has names (%d)" % len(head),

@@ -56,7 +56,7 @@ contains
               ! (a node held in place is never constrained: active_set.f90)
               if (all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
               call obstacle_point(ob, 0._dp, x(:, n), nrm, d)
-              gap = d - face_along(bi, g(:, n), nrm)
+              gap = d - face_along(c, model, bi, g(:, n), nrm)
               if (gap < r%gap) then
                 r%gap = gap; r%node = n
                 r%speed = -dot_product(v(:, n) - ob%velocity, nrm)
@@ -90,7 +90,8 @@ contains
               if (best_tri == 0) cycle
               u = x(:, n) - best_q
               if (norm2(u) > 0) u = u/norm2(u)
-              gap = best - face_along(bi, g(:, n), u) - face_along(bt, matmul(g(:, s%tri(:, best_tri)), best_bary), u)
+              gap = best - face_along(c, model, bi, g(:, n), u) - &
+                    face_along(c, model, bt, matmul(g(:, s%tri(:, best_tri)), best_bary), u)
               if (gap >= r%gap) cycle
               r%gap = gap; r%node = n
               vt = matmul(v(:, s%tri(:, best_tri)), best_bary)
@@ -101,41 +102,48 @@ contains
         end if
         ! closing: faster than rounding of the bodies' speeds (a rigid body's own surface
         ! gives 0 to rounding)
-        if (r%node > 0 .and. bi /= bt .and. r%speed > 1e-12_dp*max_speed(bi, bt)) &
+        if (r%node > 0 .and. bi /= bt .and. r%speed > 1e-12_dp*max_speed(c, model, v, bi, bt)) &
           r%time = max(r%gap, 0._dp)/r%speed
         r%speed = r%speed + 0._dp   ! (no -0 printed)
       end associate
     end do
-  contains
-    !> body b's face along u, as a new constraint chooses it (projection.f90); none between
-    !> mid-surfaces
-    real(dp) function face_along(b, gf, u)
-      integer, intent(in) :: b
-      real(dp), intent(in) :: gf(3), u(3)
-      integer :: s
-      real(dp) :: w
-      face_along = 0
-      if (.not. c%faces) return
-      s = 0
-      call face(model%body(b)%thickness, gf, u, s, face_along, w)
-    end function face_along
-
-    real(dp) function max_speed(b1, b2)
-      integer, intent(in) :: b1, b2
-      integer :: m
-      max_speed = tiny(1._dp)
-      do m = model%body(b1)%node_first, model%body(b1)%node_last
-        max_speed = max(max_speed, norm2(v(:, m)))
-      end do
-      if (b2 <= 0) then
-        max_speed = max(max_speed, norm2(c%obstacle(-b2)%velocity))
-        return
-      end if
-      do m = model%body(b2)%node_first, model%body(b2)%node_last
-        max_speed = max(max_speed, norm2(v(:, m)))
-      end do
-    end function max_speed
   end function pair_gaps
+
+  !> body b's face along u, as a new constraint chooses it (projection.f90); none between
+  !> mid-surfaces. (Module procedures, not internal ones: gfortran gave the binary an
+  !> executable stack for them.)
+  real(dp) function face_along(c, model, b, gf, u)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    real(dp), intent(in) :: gf(3), u(3)
+    integer :: s
+    real(dp) :: w
+    face_along = 0
+    if (.not. c%faces) return
+    s = 0
+    call face(model%body(b)%thickness, gf, u, s, face_along, w)
+  end function face_along
+
+  !> the fastest node of bodies b1 and b2 (or obstacle -b2)
+  real(dp) function max_speed(c, model, v, b1, b2)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: v(:, :)
+    integer, intent(in) :: b1, b2
+    integer :: m
+    max_speed = tiny(1._dp)
+    do m = model%body(b1)%node_first, model%body(b1)%node_last
+      max_speed = max(max_speed, norm2(v(:, m)))
+    end do
+    if (b2 <= 0) then
+      max_speed = max(max_speed, norm2(c%obstacle(-b2)%velocity))
+      return
+    end if
+    do m = model%body(b2)%node_first, model%body(b2)%node_last
+      max_speed = max(max_speed, norm2(v(:, m)))
+    end do
+  end function max_speed
 
   !> One line per pair: names(t) is target t's name (bodies t > 0, obstacles t = -k), then a
   !> line saying how the gap was measured.
@@ -146,13 +154,18 @@ contains
     character(len=320), allocatable :: lines(:)
     character(len=:), allocatable :: tname, kind
     character(len=40) :: when
+    character(len=10) :: skip
     integer :: ip, bi, bt
     allocate (lines(size(pg) + 1))
     do ip = 1, size(pg)
       bi = c%pair(1, ip); bt = c%pair(2, ip)
       if (bt > 0) then
         tname = trim(body_names(bt)); kind = ''
-        if (bt == bi) kind = ' (self-contact)'
+        if (bt == bi) then   ! (what a fold closer than this cannot touch: say it)
+          write (skip, '(es10.3)') c%geo%skip(bt)
+          kind = ' (self-contact; the surface within '//trim(adjustl(skip))// &
+                 ' m of a node at the start is not tested against it)'
+        end if
       else
         tname = trim(obstacle_names(-bt)); kind = ' (obstacle)'
       end if

@@ -26,7 +26,7 @@ module casca_run
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
   use casca_pair_gaps, only: pair_gap_t, pair_gaps, pair_gap_lines
-  use casca_free_flight, only: idle_bodies, advance_idle
+  use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   implicit none
@@ -338,16 +338,23 @@ contains
       if (use_contact .and. deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
     end subroutine setup_contact
 
-    !> Gravity's acceleration at the start, g on every free point (the bodies start falling;
-    !> supports hold them from the first step): with a = 0 instead the first step would
-    !> change the momentum by (gamma - 1/2) m g dt too much (thesis Newmark: 3e-5 of a
-    !> bouncing ring's momentum change). (Not M^-1 f for nodal loads: concentrated at the
-    !> loaded nodes, it makes Newton diverge on a thin strip under a point load.)
+    !> Gravity's acceleration at the start, g on every point of a free body clear of contact
+    !> (restrained or resting bodies start at rest, a = 0: their supports hold them). With 0
+    !> for a falling body the first step would change its momentum by (gamma - 1/2) m g dt
+    !> too much (thesis Newmark: 3e-5 of a bouncing ring's momentum change). (Not M^-1 f for
+    !> nodal loads: concentrated at the loaded nodes, it made Newton diverge on a thin strip
+    !> under a point load.)
     subroutine start_acceleration()
-      integer :: n, c
-      do n = 1, model%nnode
-        do c = 1, 3
-          if (.not. model%fixed(dof(n, c))) st%qdd(dof(n, c)) = model%gravity(c)
+      logical :: falls(model%nbody)
+      integer :: b, n
+      if (all(model%gravity == 0)) return
+      falls = [(.not. any(model%fixed(dof(model%body(b)%node_first, 1):dof(model%body(b)%node_last, 7))), &
+                b=1, model%nbody)]
+      if (use_contact) call clear_near_contact(model, st%q, st%qd, deck%run%dt, contact, falls)
+      do b = 1, model%nbody
+        if (.not. falls(b)) cycle
+        do n = model%body(b)%node_first, model%body(b)%node_last
+          st%qdd(dof(n, 1):dof(n, 3)) = model%gravity
         end do
       end do
     end subroutine start_acceleration

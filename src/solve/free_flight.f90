@@ -10,7 +10,7 @@ module casca_free_flight
   use casca_obstacle, only: obstacle_point
   implicit none
   private
-  public :: idle_bodies, advance_idle
+  public :: idle_bodies, clear_near_contact, advance_idle
 
 contains
 
@@ -20,24 +20,17 @@ contains
     real(dp), intent(in) :: q(:), qd(:), qdd(:), fext(:), dt
     logical, intent(out) :: idle(:)
     type(contact_t), intent(in), optional :: contact
-    real(dp) :: lo(3, model%nbody), hi(3, model%nbody), speed(model%nbody), reach
-    real(dp) :: shift(3), v(3), tol, x(3), nrm(3), d
-    logical :: near
-    integer :: b, n, k, i, j, f, l
+    real(dp) :: shift(3), v(3), tol
+    integer :: b, n, f, l
     tol = 1e-12_dp*model%length
     do b = 1, model%nbody
       associate (bd => model%body(b))
         f = dof(bd%node_first, 1); l = dof(bd%node_last, 7)
-        lo(:, b) = huge(1._dp); hi(:, b) = -huge(1._dp)
         idle(b) = .not. any(model%fixed(f:l)) .and. all(fext(f:l) == 0) .and. all(qdd(f:l) == 0)
         shift = q(dof(bd%node_first, 1):dof(bd%node_first, 3)) - model%x0(:, bd%node_first)
         v = qd(dof(bd%node_first, 1):dof(bd%node_first, 3))
-        speed(b) = 0
         do n = bd%node_first, bd%node_last
-          lo(:, b) = min(lo(:, b), q(dof(n, 1):dof(n, 3)))
-          hi(:, b) = max(hi(:, b), q(dof(n, 1):dof(n, 3)))
-          speed(b) = max(speed(b), norm2(qd(dof(n, 1):dof(n, 3))))
-          if (.not. idle(b)) cycle
+          if (.not. idle(b)) exit
           idle(b) = all(abs(q(dof(n, 1):dof(n, 3)) - model%x0(:, n) - shift) <= tol) .and. &
                     all(abs(q(dof(n, 4):dof(n, 6)) - model%v0(:, n)) <= 1e-12_dp) .and. &
                     abs(q(dof(n, 7))) <= 1e-12_dp .and. &
@@ -45,20 +38,40 @@ contains
         end do
       end associate
     end do
-    if (.not. present(contact)) return
+    if (present(contact)) call clear_near_contact(model, q, qd, dt, contact, idle)
+  end subroutine idle_bodies
+
+  !> Clear far(b) of the bodies in contact, or with an impactor node that could reach its
+  !> target within two steps of dt
+  subroutine clear_near_contact(model, q, qd, dt, contact, far)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:), qd(:), dt
+    type(contact_t), intent(in) :: contact
+    logical, intent(inout) :: far(:)
+    real(dp) :: lo(3, model%nbody), hi(3, model%nbody), speed(model%nbody), reach, x(3), nrm(3), d
+    logical :: near
+    integer :: b, n, k, i, j
+    do b = 1, model%nbody
+      lo(:, b) = huge(1._dp); hi(:, b) = -huge(1._dp); speed(b) = 0
+      do n = model%body(b)%node_first, model%body(b)%node_last
+        lo(:, b) = min(lo(:, b), q(dof(n, 1):dof(n, 3)))
+        hi(:, b) = max(hi(:, b), q(dof(n, 1):dof(n, 3)))
+        speed(b) = max(speed(b), norm2(qd(dof(n, 1):dof(n, 3))))
+      end do
+    end do
     do k = 1, contact%nact   ! bodies in contact
       i = model%node_body(contact%act(k)%node)
-      idle(i) = .false.
+      far(i) = .false.
       j = contact%pair(2, contact%act(k)%pair)
-      if (j > 0) idle(j) = .false.
+      if (j > 0) far(j) = .false.
     end do
     do k = 1, contact%npairs  ! an impactor node that could reach the target within two steps
       i = contact%pair(1, k); j = contact%pair(2, k)
       if (j > 0) then
-        if (.not. (idle(i) .or. idle(j))) cycle
+        if (.not. (far(i) .or. far(j))) cycle
         reach = 2*dt*(speed(i) + speed(j)) + contact%tol + face_reach(contact, model, i, j)
       else
-        if (.not. idle(i)) cycle
+        if (.not. far(i)) cycle
         reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%tol + &
                 face_reach(contact, model, i, j)
       end if
@@ -71,13 +84,13 @@ contains
           near = d <= reach
         end if
         if (near) then
-          idle(i) = .false.
-          if (j > 0) idle(j) = .false.
+          far(i) = .false.
+          if (j > 0) far(j) = .false.
           exit
         end if
       end do
     end do
-  end subroutine idle_bodies
+  end subroutine clear_near_contact
 
   !> The exact Newmark step of an idle body: q += dt v, v kept, acceleration zero.
   pure subroutine advance_idle(model, idle, dt, q_before, qd_before, q, qd, qdd)
