@@ -459,6 +459,11 @@ contains
       call output_close(out, e)
       if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
         '/checkpoint.h5 (restart with --restart) and in the last frame of '//dir//'/run.pvd'
+      ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
+      ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
+      if (is_root() .and. nm%gamma <= 0.5_dp .and. deck%run%analysis /= 'static') write (0, '(a)') &
+        'hint: gamma = 0.5 keeps the shells'' fastest vibrations undamped, which can stall Newton; '// &
+        'beta = 0.3025, gamma = 0.6 damps them (or the thesis'' beta = 1, gamma = 1.5)'
       code = exit_solver
     end subroutine give_up
 
