@@ -120,6 +120,23 @@ if h.shape == ref.shape:
           np.max(np.abs(t5 - ref) / scale) if t5.shape == ref.shape else np.inf, 1e-12)
 ck.record("the folder's lock is gone after the last run", not os.path.exists(os.path.join(kill_out, "casca.lock")))
 
+# --- a restart into a new folder (--out elsewhere): it carries on the checkpoint folder's
+# history, which ends as the uninterrupted run's (1e-12), and leaves the old folder as it was
+part_out, new_out = os.path.join(work, "part"), os.path.join(work, "moved")
+p = run([casca, "run", deck("part", t_end="5.0e-3", out=part_out), "-q"])
+before = open(os.path.join(part_out, "history.dat")).read()
+p = run([casca, "run", deck("moved", out=part_out), "-q", "--out", new_out,
+         "--restart", os.path.join(part_out, "checkpoint.h5")])
+ck.record("restart into a new folder: exit 0", p.returncode == 0, first_line(p))
+if p.returncode == 0:
+    h = np.loadtxt(os.path.join(new_out, "history.dat"))
+    ok = h.shape == ref.shape
+    ck.le("restart into a new folder: its history.dat vs the uninterrupted run's (max relative to each "
+          "column's size)", np.max(np.abs(h - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300)) if ok
+          else np.inf, 1e-12)
+    ck.record("restart into a new folder: the checkpoint's folder keeps its history",
+              open(os.path.join(part_out, "history.dat")).read() == before)
+
 # --- two runs into one folder: the second is refused (exit 2) while the first runs, and the
 # first ends as if alone (its history equals the uninterrupted run's, no NUL byte)
 lock_out = os.path.join(work, "locked")

@@ -7,7 +7,7 @@ module casca_files
   implicit none
   private
   public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line, file_kind, &
-            physical_memory, close_complete
+            physical_memory, close_complete, folder_of
   !> kinds of file_kind
   integer, parameter, public :: kind_missing = 0, kind_regular = 1, kind_folder = 2, kind_special = 3
 
@@ -116,6 +116,21 @@ contains
     close (u, iostat=ios)
     close_complete = ios == 0 .and. file_kind(path, size) == kind_regular .and. size == pos - 1
   end function close_complete
+
+  !> The folder that holds path: '.' for a bare name, '/' for a file at the root
+  pure function folder_of(path) result(folder)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: folder
+    integer :: k
+    k = index(path, '/', back=.true.)
+    if (k == 0) then
+      folder = '.'
+    else if (k == 1) then
+      folder = '/'
+    else
+      folder = path(1:k - 1)
+    end if
+  end function folder_of
 
   !> Remove a file if it exists (a failed .part).
   subroutine delete_file(path)

@@ -26,6 +26,7 @@ module casca_run
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
   use casca_pair_gaps, only: pair_gap_t, pair_gaps, pair_gap_lines
+  use casca_files, only: folder_of
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
@@ -145,17 +146,22 @@ contains
     type(newmark_t) :: nm
     type(balance_t) :: bal, bal0   !< now, and at the start of the run
     type(output_t) :: out
-    type(contact_t) :: contact
+    type(contact_t), allocatable :: contact   !< not allocated: no contact (absent below)
     type(error_t), allocatable :: err
     real(dp), allocatable :: fext(:), fgrav(:), q0(:), q_before(:), qd_before(:)
     logical, allocatable :: frozen(:), idle(:)
     integer, allocatable :: tracked(:)
     character(len=128), allocatable :: labels(:)
     character(len=:), allocatable :: dir
-    real(dp) :: interval, next_frame, next_ckpt, t0, t_start, dt
+    real(dp) :: interval, next_frame, next_ckpt, t0, dt
     integer :: level, k, restart_step, total_newton
     logical :: missing, use_contact
     real(dp) :: pen, gmax
+    type :: progress_t   !< where the last progress line was
+      real(dp) :: wall = 0, t = 0
+      integer :: step = 0, newton = 0
+    end type progress_t
+    type(progress_t) :: last
 
     code = exit_ok
     call load_scene(path, deck, model, code)
@@ -188,20 +194,15 @@ contains
 
     level = 0; restart_step = -1
     if (restart /= '') then   ! (statics: t is the load factor, <= 1)
-      if (use_contact) then
-        call load_checkpoint(restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
-                             'static'), deck%run%max_step_cuts, st, level, err, contact)
-      else
-        call load_checkpoint(restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
-                             'static'), deck%run%max_step_cuts, st, level, err)
-      end if
+      call load_checkpoint(restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
+                           'static'), deck%run%max_step_cuts, st, level, err, contact)
       if (failed('restart')) return
       restart_step = st%step
     end if
     call open_history()
     if (failed('output')) return
 
-    t0 = wall_time(); t_start = st%t
+    t0 = wall_time()
     if (deck%run%analysis == 'static') then
       call static_run()
       return
@@ -231,6 +232,7 @@ contains
       'casca: bodies solved on ', (trim(model%body(k)%name)//': '//ranks_of(k), k=1, model%nbody)
 
     total_newton = 0
+    last = progress_t(t0, st%t, st%step, 0)
     allocate (frozen(model%ndof), idle(model%nbody))
     frozen = .false.; idle = .false.
     do while (st%t < deck%run%t_end - 1e-9_dp*dt)
@@ -240,11 +242,7 @@ contains
         call give_up(err%message); return
       end if
       q_before = st%q; qd_before = st%qd
-      if (use_contact) then
-        call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
-      else
-        call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err)
-      end if
+      call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
       if (allocated(err)) then
         if (level < deck%run%max_step_cuts) then
           level = level + 1   ! the state is unchanged: retry with half the step
@@ -291,12 +289,8 @@ contains
     subroutine update_frozen()
       logical, allocatable :: fz(:)
       integer :: b
-      if (use_contact) then
-        contact%time = st%t
-        call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle, contact)
-      else
-        call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle)
-      end if
+      if (use_contact) contact%time = st%t
+      call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle, contact)
       allocate (fz(model%ndof))
       fz = .false.
       do b = 1, model%nbody
@@ -333,7 +327,9 @@ contains
     end function split_bodies
 
     subroutine setup_contact()
+      allocate (contact)
       call scene_contact(deck, model, contact, use_contact)
+      if (.not. use_contact) deallocate (contact)
       ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
       if (use_contact .and. deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
     end subroutine setup_contact
@@ -374,7 +370,7 @@ contains
                          k=-size(deck%obstacles), -1), '-', body_names], -size(deck%obstacles), pair_names)
       end if
       call output_open(out, dir, tracked, labels, body_names, pair_names, friction, &
-                       moving_obstacles(deck, use_contact), restart_step, st%t, err)
+                       moving_obstacles(deck, use_contact), restart_step, st%t, err, folder_of(restart))
     end subroutine open_history
 
     subroutine history_row(newton)
@@ -421,24 +417,27 @@ contains
       end if
     end function failed
 
+    !> One line per frame: Newton iterations per step and the time left from the frame
+    !> interval just done (contact makes later steps dearer than the first ones: from the
+    !> start, a run that took 175 s had said 11 s left)
     subroutine progress()
-      real(dp) :: el
-      el = wall_time() - t0
+      real(dp) :: now, rate
+      integer :: nc
+      now = wall_time()
+      rate = (now - last%wall)/max(st%t - last%t, tiny(1._dp))
+      nc = 0
+      if (use_contact) nc = contact%nact
       print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
-        '  dt', nm%dt, '  newton/step', real(total_newton)/max(st%step - max(restart_step, 0), 1), &
-        '  contacts', merge(contact%nact, 0, use_contact), '  elapsed', el, ' s  left', &
-        el*max(deck%run%t_end - st%t, 0._dp)/max(st%t - t_start, tiny(1._dp)), ' s'
+        '  dt', nm%dt, '  newton/step', real(total_newton - last%newton)/max(st%step - last%step, 1), &
+        '  contacts', nc, '  elapsed', now - t0, ' s  left', rate*max(deck%run%t_end - st%t, 0._dp), ' s'
+      last = progress_t(now, st%t, st%step, total_newton)
     end subroutine progress
 
     subroutine checkpoint()
       type(error_t), allocatable :: e
       call ls%drop_factors()   ! on every rank: a restart from here starts with new factors
       call output_flush(out, e)   ! the history up to this step, for a restart from here
-      if (.not. allocated(e) .and. use_contact) then
-        call save_checkpoint(dir//'/checkpoint.h5', model, st, level, contact, e)
-      else if (.not. allocated(e)) then
-        call save_checkpoint(dir//'/checkpoint.h5', model, st, level, err=e)
-      end if
+      if (.not. allocated(e)) call save_checkpoint(dir//'/checkpoint.h5', model, st, level, contact, e)
       call share_error(e)
       if (allocated(e)) then
         if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message
@@ -489,7 +488,7 @@ contains
         if (deck%run%analysis /= 'static' .and. restart_step < 0) then
           print '(a)', balance_summary(bal0, bal, model%length, any(model%fixed) .or. &
                                        any(fext /= 0) .or. any(fgrav /= 0) .or. size(deck%obstacles) > 0)
-          print '(a)', energy_balance(bal0, bal, balance_terms(deck, contact, use_contact))
+          print '(a)', energy_balance(bal0, bal, balance_terms(deck, contact))
         end if
       end if
     end subroutine finish
@@ -499,13 +498,8 @@ contains
     subroutine static_run()
       integer :: i
       do i = 1, deck%run%load_steps
-        if (use_contact) then
-          call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
-                            deck%run%max_step_cuts, opts, st%q, rep, err, contact)
-        else
-          call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
-                            deck%run%max_step_cuts, opts, st%q, rep, err)
-        end if
+        call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
+                          deck%run%max_step_cuts, opts, st%q, rep, err, contact)
         if (allocated(err)) then
           call give_up(err%message); return
         end if
@@ -523,16 +517,15 @@ contains
     end subroutine static_run
   end subroutine run_deck
   !> The energy balance's terms that the scene has: friction's, moving obstacles'
-  function balance_terms(deck, contact, use_contact) result(terms)
+  function balance_terms(deck, contact) result(terms)
     type(deck_t), intent(in) :: deck
-    type(contact_t), intent(in) :: contact
-    logical, intent(in) :: use_contact
+    type(contact_t), intent(in), optional :: contact
     type(energy_term_t), allocatable :: terms(:)
     allocate (terms(0))
-    if (.not. use_contact) return
+    if (.not. present(contact)) return
     if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
                                                              sum(contact%friction_work))]
-    if (moving_obstacles(deck, use_contact)) &
+    if (moving_obstacles(deck, .true.)) &
       terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
   end function balance_terms
 

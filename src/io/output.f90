@@ -16,7 +16,7 @@ module casca_output
                            h5_table_close
   use casca_mpi, only: is_root
   use casca_strings, only: itoa
-  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line
+  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line, file_kind, kind_missing
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder
@@ -96,7 +96,7 @@ contains
   !> keep what an earlier run wrote up to that step (and the frames up to restart_time) and
   !> append after it. bodies: the bodies' names; pairs: a label per contact pair.
   subroutine output_open(out, dir, tracked, labels, bodies, pairs, friction, moving, restart_step, &
-                         restart_time, err)
+                         restart_time, err, restart_dir)
     type(output_t), intent(out) :: out
     logical, intent(in) :: friction, moving
     character(len=*), intent(in) :: dir
@@ -105,8 +105,9 @@ contains
     integer, intent(in) :: restart_step
     real(dp), intent(in) :: restart_time
     type(error_t), allocatable, intent(out) :: err
+    character(len=*), intent(in), optional :: restart_dir   !< the checkpoint's folder
     character(len=col_len), allocatable :: cols(:)
-    character(len=:), allocatable :: note
+    character(len=:), allocatable :: note, earlier
     integer :: ios
     character(len=256) :: msg
 
@@ -125,7 +126,11 @@ contains
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
     cols = history_columns(size(tracked), bodies, pairs, friction, moving)
-    if (restart_step < 0) then
+    ! a restart into a new folder carries on the checkpoint folder's history (its frames stay
+    ! there); with none at all, the history starts at the restart
+    earlier = out%dir//'/history.dat'
+    if (file_kind(earlier) == kind_missing .and. present(restart_dir)) earlier = restart_dir//'/history.dat'
+    if (restart_step < 0 .or. file_kind(earlier) == kind_missing) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return
       out%hist_open = .true.
@@ -133,7 +138,7 @@ contains
       if (allocated(err)) return
       call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     else
-      call keep_history(out, cols, restart_step, err)
+      call keep_history(out, cols, restart_step, earlier, err)
       if (allocated(err)) return
       call keep_frames(restart_time, err)
     end if
@@ -165,13 +170,14 @@ contains
     end subroutine keep_frames
   end subroutine output_open
 
-  !> Restart: cut history.dat back to the rows of steps <= last (rows after the checkpoint, or
-  !> a line cut short by a crash, go), which must end at step last, and make history.h5 anew
+  !> Restart: cut history.dat (from earlier: this folder's, or the checkpoint folder's) back to
+  !> the rows of steps <= last (rows after the checkpoint, or a line cut short by a crash, go),
+  !> which must end at step last, and make history.h5 anew
   !> from them: the .dat is flushed at every checkpoint, while an HDF5 file killed between two
   !> flushes may be unreadable. Nothing is changed unless the history reaches step last.
-  subroutine keep_history(out, cols, last, err)
+  subroutine keep_history(out, cols, last, earlier, err)
     type(output_t), intent(inout) :: out
-    character(len=*), intent(in) :: cols(:)
+    character(len=*), intent(in) :: cols(:), earlier
     integer, intent(in) :: last
     type(error_t), allocatable, intent(out) :: err
     character(len=:), allocatable :: path
@@ -180,7 +186,7 @@ contains
     real(dp) :: row(size(cols))
     integer :: u, ios
     path = out%dir//'/history.dat'
-    call cut_history(path, size(cols), last, err)
+    call cut_history(earlier, path, size(cols), last, err)
     if (allocated(err)) return
     call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     if (allocated(err)) return
@@ -199,10 +205,11 @@ contains
     out%hist_open = .not. allocated(err)
   end subroutine keep_history
 
-  !> Replace the history file path by its header and rows (of ncol numbers) up to step last,
-  !> written to path.part and renamed when complete; an error if the rows end before last.
-  subroutine cut_history(path, ncol, last, err)
-    character(len=*), intent(in) :: path
+  !> Replace the history file path by the header and rows (of ncol numbers) up to step last of
+  !> the history earlier (path itself, or another folder's), written to path.part and renamed
+  !> when complete; an error if the rows end before last.
+  subroutine cut_history(earlier, path, ncol, last, err)
+    character(len=*), intent(in) :: earlier, path
     integer, intent(in) :: ncol, last
     type(error_t), allocatable, intent(out) :: err
     type(checked_file_t) :: part
@@ -210,9 +217,9 @@ contains
     character(len=256) :: msg
     real(dp) :: row(ncol)
     integer :: u, ios, step
-    open (newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+    open (newunit=u, file=earlier, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
-      call fatal_error(err, 'restart: '//path//': '//trim(msg)); return
+      call fatal_error(err, 'restart: '//earlier//': '//trim(msg)); return
     end if
     call cf_open(part, path//'.part', 'w', err)
     step = -1
@@ -229,7 +236,7 @@ contains
     close (u)
     if (.not. allocated(err)) call cf_close(part, err)
     if (.not. allocated(err) .and. step /= last) &
-      call fatal_error(err, 'restart: '//path//' ends at step '//itoa(step)// &
+      call fatal_error(err, 'restart: '//earlier//' ends at step '//itoa(step)// &
                        ', before the checkpoint''s step '//itoa(last)//' (another run''s history?)')
     if (allocated(err)) then
       call cf_discard(part); return
