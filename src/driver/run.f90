@@ -29,12 +29,44 @@ module casca_run
   use casca_files, only: folder_of
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
+  use casca_strings, only: count_of
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   implicit none
   private
   public :: load_scene, run_deck
 
   integer, parameter, public :: exit_ok = 0, exit_input = 2, exit_solver = 3
+
+  type :: progress_t   !< where the last progress line was
+    real(dp) :: wall = 0, t = 0
+    integer :: step = 0, newton = 0
+  end type progress_t
+
+  !> One run of a deck: what it builds and what it carries from step to step
+  type :: run_t
+    type(deck_t) :: deck
+    type(model_t) :: model
+    type(assembly_t) :: asm
+    type(linear_system_t), allocatable :: ls
+    type(newton_opts_t) :: opts
+    type(newton_report_t) :: rep
+    type(state_t) :: st
+    type(newmark_t) :: nm
+    type(balance_t) :: bal, bal0                !< now, and at the start of the run
+    type(output_t) :: out
+    type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
+    type(error_t), allocatable :: err
+    real(dp), allocatable :: fext(:), q0(:)     !< dead loads with gravity; reference state
+    logical, allocatable :: frozen(:), idle(:)  !< idle bodies, left out of the equations
+    integer, allocatable :: tracked(:)
+    character(len=128), allocatable :: labels(:)
+    character(len=:), allocatable :: dir, restart
+    real(dp) :: t0 = 0                          !< wall time at the start
+    integer :: level = 0                        !< step cuts: dt / 2**level
+    integer :: restart_step = -1, total_newton = 0, code = exit_ok
+    logical :: quiet = .false.
+    type(progress_t) :: last
+  end type run_t
 
 contains
 
@@ -60,7 +92,7 @@ contains
         do i = 1, deck%nproblems
           write (0, '(a,a)') 'error: ', trim(deck%problems(i))
         end do
-        write (0, '(i0,a)') deck%nproblems, ' problem(s) in the deck; nothing was run'
+        write (0, '(a)') count_of(deck%nproblems, 'problem', 'problems')//' in the deck; nothing was run'
       end if
       code = exit_input
     end if
@@ -80,11 +112,11 @@ contains
       if (added == 0) return
       worst = minloc(probe%act(1:probe%nact)%gap, dim=1)
       k = probe%act(worst)%node
-      write (msg, '(a,a,a,a,a,i0,a,es10.3,a,i0,a)') 'bodies ''', &
+      write (msg, '(a,a,a,a,a,i0,a,es10.3,a)') 'bodies ''', &
         trim(model%body(model%node_body(k))%name), ''' and ''', &
         trim(target_name(probe%pair(2, probe%act(worst)%pair))), ''' overlap at the start: node ', &
-        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, &
-        ' m inside (', added, ' nodes in all); move them apart'
+        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, ' m inside ('
+      msg = trim(msg)//count_of(added, 'node', 'nodes')//' in all); move them apart'
       if (probe%faces) msg = trim(msg)//' (contact is between the shell faces: half of each '// &
                              'thickness from the mid-surface)'
       call add_problem(deck, 0, trim(msg))
@@ -132,390 +164,425 @@ contains
     end function target_name
   end subroutine load_scene
 
+  !> Run the deck at path into out_dir (the deck's folder if '') from t = 0, or from the
+  !> checkpoint restart; code: exit_ok, exit_input or exit_solver.
   subroutine run_deck(path, out_dir, restart, quiet, code)
     character(len=*), intent(in) :: path, out_dir, restart
     logical, intent(in) :: quiet
     integer, intent(out) :: code
-    type(deck_t) :: deck
-    type(model_t) :: model
-    type(assembly_t) :: asm
-    type(linear_system_t), allocatable :: ls   ! (large: MUMPS structures)
-    type(newton_opts_t) :: opts
-    type(newton_report_t) :: rep
-    type(state_t) :: st
-    type(newmark_t) :: nm
-    type(balance_t) :: bal, bal0   !< now, and at the start of the run
-    type(output_t) :: out
-    type(contact_t), allocatable :: contact   !< not allocated: no contact (absent below)
-    type(error_t), allocatable :: err
-    real(dp), allocatable :: fext(:), fgrav(:), q0(:), q_before(:), qd_before(:)
-    logical, allocatable :: frozen(:), idle(:)
-    integer, allocatable :: tracked(:)
-    character(len=128), allocatable :: labels(:)
-    character(len=:), allocatable :: dir
-    real(dp) :: interval, next_frame, next_ckpt, t0, dt
-    integer :: level, k, restart_step, total_newton
-    logical :: missing, use_contact
-    real(dp) :: pen, gmax
-    type :: progress_t   !< where the last progress line was
-      real(dp) :: wall = 0, t = 0
-      integer :: step = 0, newton = 0
-    end type progress_t
-    type(progress_t) :: last
-
-    code = exit_ok
-    call load_scene(path, deck, model, code)
-    if (code /= exit_ok) return
-    allocate (ls)
-    dir = trim(deck%output%dir)
-    if (out_dir /= '') dir = trim(out_dir)
-
-    call setup_contact()
-    if (failed('setup')) return
-    call assembly_setup(model, asm, err, split=split_bodies())
-    if (failed('setup')) return
-    if (deck%run%ordering == 'metis') ls%solver%ordering = 1
-    opts%tol = deck%run%newton_tol; opts%max_iter = deck%run%newton_max_iter
-    opts%reuse = deck%run%reuse_factorisation
-    allocate (fgrav(model%ndof))
-    call gravity_load(model, fgrav)
-    fext = model%fext + fgrav
-    call tracked_nodes(deck, model, tracked)
-    allocate (labels(size(tracked)))
-    do k = 1, size(tracked)
-      write (labels(k), '(a,a,i0,a,3(g0.4,:,", "))') trim(model%body(model%node_body(tracked(k)))%name), &
-        ' node ', tracked(k) - model%body(model%node_body(tracked(k)))%node_first + 1, &
-        ' near (', deck%output%track(:, k)
-      labels(k) = trim(labels(k))//')'
-    end do
-    call initial_state(deck, model, st)
-    allocate (q0(model%ndof))
-    call reference_state(model, q0)
-
-    level = 0; restart_step = -1
-    if (restart /= '') then   ! (statics: t is the load factor, <= 1)
-      call load_checkpoint(restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
-                           'static'), deck%run%max_step_cuts, st, level, err, contact)
-      if (failed('restart')) return
-      restart_step = st%step
-    end if
-    call open_history()
-    if (failed('output')) return
-
-    t0 = wall_time()
-    if (deck%run%analysis == 'static') then
-      call static_run()
-      return
-    end if
-
-    nm%beta = deck%run%beta; nm%gamma = deck%run%gamma
-    dt = deck%run%dt
-    interval = deck%output%interval
-    if (interval == unset) interval = deck%run%t_end/100
-    interval = max(interval, dt)
-    next_frame = (floor(st%t/interval + 1e-9_dp) + 1)*interval
-    next_ckpt = huge(1._dp)
-    if (deck%output%checkpoint_interval > 0) &
-      next_ckpt = (floor(st%t/deck%output%checkpoint_interval + 1e-9_dp) + 1)*deck%output%checkpoint_interval
-    if (restart_step < 0) then
-      call start_acceleration()
-      call account(model, asm, st, fext, q0, bal)
-      bal0 = bal
-      call history_row(0)
-      if (failed('history')) return
-      call frame()
-      if (failed('frame')) return
-    end if
-    if (is_root() .and. .not. quiet) print '(a,i0,a,i0,a,i0,a,i0,a)', 'casca: ', model%nbody, &
-      ' bodies, ', model%nelem, ' elements, ', asm%neq_total, ' unknowns, ', n_ranks, ' rank(s)'
-    if (is_root() .and. .not. quiet .and. n_ranks > 1) print '(a,*(a,:,"; "))', &
-      'casca: bodies solved on ', (trim(model%body(k)%name)//': '//ranks_of(k), k=1, model%nbody)
-
-    total_newton = 0
-    last = progress_t(t0, st%t, st%step, 0)
-    allocate (frozen(model%ndof), idle(model%nbody))
-    frozen = .false.; idle = .false.
-    do while (st%t < deck%run%t_end - 1e-9_dp*dt)
-      nm%dt = min(dt/2**level, deck%run%t_end - st%t)
-      if (deck%run%skip_idle_bodies) call update_frozen()
-      if (allocated(err)) then
-        call give_up(err%message); return
+    type(run_t), allocatable :: r   ! (large: MUMPS structures)
+    allocate (r)
+    r%quiet = quiet; r%restart = restart
+    call run_setup(r, path, out_dir)
+    if (r%code == exit_ok) then
+      if (r%deck%run%analysis == 'static') then
+        call static_run(r)
+      else
+        call dynamic_run(r)
       end if
-      q_before = st%q; qd_before = st%qd
-      call newmark_step(model, asm, ls, nm, fext, opts, st, rep, err, contact)
-      if (allocated(err)) then
-        if (level < deck%run%max_step_cuts) then
-          level = level + 1   ! the state is unchanged: retry with half the step
-          if (is_root() .and. .not. quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
-            dt/2**level, ': ', err%message
-          deallocate (err)
-          cycle
+    end if
+    code = r%code
+  end subroutine run_deck
+
+  !> Read and build the scene, its contact and equations, the start (t = 0 or the
+  !> checkpoint's) and the output folder
+  subroutine run_setup(r, path, out_dir)
+    type(run_t), intent(inout) :: r
+    character(len=*), intent(in) :: path, out_dir
+    integer :: k
+    call load_scene(path, r%deck, r%model, r%code)
+    if (r%code /= exit_ok) return
+    allocate (r%ls)
+    r%dir = trim(r%deck%output%dir)
+    if (out_dir /= '') r%dir = trim(out_dir)
+    associate (deck => r%deck, model => r%model)
+      call setup_contact(r)
+      if (failed(r, 'setup')) return
+      call assembly_setup(model, r%asm, r%err, split=r%ls%schur)
+      if (failed(r, 'setup')) return
+      if (deck%run%ordering == 'metis') r%ls%solver%ordering = 1
+      r%opts%tol = deck%run%newton_tol; r%opts%max_iter = deck%run%newton_max_iter
+      r%opts%reuse = deck%run%reuse_factorisation
+      allocate (r%fext(model%ndof))
+      call gravity_load(model, r%fext)
+      r%fext = r%fext + model%fext
+      call tracked_nodes(deck, model, r%tracked)
+      allocate (r%labels(size(r%tracked)))
+      do k = 1, size(r%tracked)
+        associate (b => model%body(model%node_body(r%tracked(k))))
+          write (r%labels(k), '(a,a,i0,a,3(g0.4,:,", "))') trim(b%name), ' node ', &
+            r%tracked(k) - b%node_first + 1, ' near (', deck%output%track(:, k)
+        end associate
+        r%labels(k) = trim(r%labels(k))//')'
+      end do
+      call initial_state(deck, model, r%st)
+      allocate (r%q0(model%ndof))
+      call reference_state(model, r%q0)
+      if (r%restart /= '') then   ! (statics: t is the load factor, <= 1)
+        call load_checkpoint(r%restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
+                             'static'), deck%run%max_step_cuts, r%st, r%level, r%err, r%contact)
+        if (failed(r, 'restart')) return
+        r%restart_step = r%st%step
+      end if
+    end associate
+    call open_history(r)
+    if (failed(r, 'output')) return
+    r%t0 = wall_time()
+  end subroutine run_setup
+
+  !> The time loop: a Newmark step (halved when it fails, grown back when Newton is at ease),
+  !> the idle bodies' exact advance, the balance, the history row, frames and checkpoints
+  subroutine dynamic_run(r)
+    type(run_t), intent(inout) :: r
+    real(dp) :: interval, next_frame, next_ckpt, dt
+    real(dp), allocatable :: q_before(:), qd_before(:)
+    integer :: k
+    associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm, rep => r%rep)
+      nm%beta = deck%run%beta; nm%gamma = deck%run%gamma
+      dt = deck%run%dt
+      interval = deck%output%interval
+      if (interval == unset) interval = deck%run%t_end/100
+      interval = max(interval, dt)
+      next_frame = (floor(st%t/interval + 1e-9_dp) + 1)*interval
+      next_ckpt = huge(1._dp)
+      if (deck%output%checkpoint_interval > 0) &
+        next_ckpt = (floor(st%t/deck%output%checkpoint_interval + 1e-9_dp) + 1)*deck%output%checkpoint_interval
+      if (r%restart_step < 0) then
+        call start_acceleration(r)
+        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        r%bal0 = r%bal
+        call history_row(r, 0)
+        if (failed(r, 'history')) return
+        call frame(r)
+        if (failed(r, 'frame')) return
+      end if
+      if (is_root() .and. .not. r%quiet) print '(a)', 'casca: '//count_of(model%nbody, 'body', 'bodies')// &
+        ', '//count_of(model%nelem, 'element', 'elements')//', '// &
+        count_of(r%asm%neq_total, 'unknown', 'unknowns')//', '//count_of(n_ranks, 'rank', 'ranks')
+      if (is_root() .and. .not. r%quiet .and. n_ranks > 1) print '(a,*(a,:,"; "))', &
+        'casca: bodies solved on ', (trim(model%body(k)%name)//': '//ranks_of(r, k), k=1, model%nbody)
+
+      r%last = progress_t(r%t0, st%t, st%step, 0)
+      allocate (r%frozen(model%ndof), r%idle(model%nbody))
+      r%frozen = .false.; r%idle = .false.
+      do while (st%t < deck%run%t_end - 1e-9_dp*dt)
+        nm%dt = min(dt/2**r%level, deck%run%t_end - st%t)
+        if (deck%run%skip_idle_bodies) call update_frozen(r)
+        if (allocated(r%err)) then
+          call give_up(r, r%err%message); return
         end if
-        call give_up(err%message)
-        return
-      end if
-      total_newton = total_newton + rep%iters
-      if (any(idle)) call advance_idle(model, idle, nm%dt, q_before, qd_before, st%q, st%qd, st%qdd)
-      if (level > 0 .and. rep%iters <= 3) level = level - 1   ! Newton is at ease: grow back
-      call timer_start(t_account)
-      call account(model, asm, st, fext, q0, bal)
-      call timer_stop(t_account)
-      call timer_start(t_output)
-      call history_row(rep%iters)
-      call timer_stop(t_output)
-      if (failed('history')) return
-      if (st%t >= next_frame - 1e-9_dp*dt .or. st%t >= deck%run%t_end - 1e-9_dp*dt) then
+        q_before = st%q; qd_before = st%qd
+        call newmark_step(model, r%asm, r%ls, nm, r%fext, r%opts, st, rep, r%err, r%contact)
+        if (allocated(r%err)) then
+          if (r%level < deck%run%max_step_cuts) then
+            r%level = r%level + 1   ! the state is unchanged: retry with half the step
+            if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
+              dt/2**r%level, ': ', r%err%message
+            deallocate (r%err)
+            cycle
+          end if
+          call give_up(r, r%err%message)
+          return
+        end if
+        r%total_newton = r%total_newton + rep%iters
+        if (any(r%idle)) call advance_idle(model, r%idle, nm%dt, q_before, qd_before, st%q, st%qd, st%qdd)
+        if (r%level > 0 .and. rep%iters <= 3) r%level = r%level - 1   ! Newton is at ease: grow back
+        call timer_start(t_account)
+        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        call timer_stop(t_account)
         call timer_start(t_output)
-        call frame()
+        call history_row(r, rep%iters)
         call timer_stop(t_output)
-        if (failed('frame')) return
-        next_frame = next_frame + interval
-        if (is_root() .and. .not. quiet) call progress()
-      end if
-      if (st%t >= next_ckpt - 1e-9_dp*dt) then
-        call checkpoint()
-        if (code /= exit_ok) return
-        next_ckpt = next_ckpt + deck%output%checkpoint_interval
-      end if
-    end do
-    call checkpoint()
-    if (code /= exit_ok) return
-    call finish()
+        if (failed(r, 'history')) return
+        if (st%t >= next_frame - 1e-9_dp*dt .or. st%t >= deck%run%t_end - 1e-9_dp*dt) then
+          call timer_start(t_output)
+          call frame(r)
+          call timer_stop(t_output)
+          if (failed(r, 'frame')) return
+          next_frame = next_frame + interval
+          if (is_root() .and. .not. r%quiet) call progress(r)
+        end if
+        if (st%t >= next_ckpt - 1e-9_dp*dt) then
+          call checkpoint(r)
+          if (r%code /= exit_ok) return
+          next_ckpt = next_ckpt + deck%output%checkpoint_interval
+        end if
+      end do
+    end associate
+    call checkpoint(r)
+    if (r%code /= exit_ok) return
+    call finish(r)
+  end subroutine dynamic_run
 
-  contains
+  !> Statics: load steps of the dead loads; one history row and frame per load step
+  !> (t = load factor).
+  subroutine static_run(r)
+    type(run_t), intent(inout) :: r
+    integer :: i
+    associate (deck => r%deck, st => r%st)
+      do i = 1, deck%run%load_steps
+        call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/deck%run%load_steps, &
+                          deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, r%contact)
+        if (allocated(r%err)) then
+          call give_up(r, r%err%message); return
+        end if
+        st%t = real(i, dp)/deck%run%load_steps; st%step = i
+        call account(r%model, r%asm, st, r%fext*st%t, r%q0, r%bal)
+        call history_row(r, r%rep%iters)
+        if (failed(r, 'history')) return
+        call frame(r)
+        if (failed(r, 'frame')) return
+        if (is_root() .and. .not. r%quiet) print '(a,i4,a,f6.3,a,i3)', 'load step', i, &
+          '  factor', st%t, '  newton', r%rep%iters
+      end do
+    end associate
+    call checkpoint(r)
+    call finish(r)
+  end subroutine static_run
 
-    !> Leave the bodies that need no solving this step out of the equations (re-analysed
-    !> only when that set changes).
-    subroutine update_frozen()
-      logical, allocatable :: fz(:)
-      integer :: b
-      if (use_contact) contact%time = st%t
-      call idle_bodies(model, st%q, st%qd, st%qdd, fext, nm%dt, idle, contact)
+  !> Leave the bodies that need no solving this step out of the equations (re-analysed
+  !> only when that set changes).
+  subroutine update_frozen(r)
+    type(run_t), intent(inout) :: r
+    logical, allocatable :: fz(:)
+    integer :: b
+    associate (model => r%model, st => r%st)
+      if (allocated(r%contact)) r%contact%time = st%t
+      call idle_bodies(model, st%q, st%qd, st%qdd, r%fext, r%nm%dt, r%idle, r%contact)
       allocate (fz(model%ndof))
       fz = .false.
       do b = 1, model%nbody
-        if (idle(b)) fz(dof(model%body(b)%node_first, 1):dof(model%body(b)%node_last, 7)) = .true.
+        if (r%idle(b)) fz(dof(model%body(b)%node_first, 1):dof(model%body(b)%node_last, 7)) = .true.
       end do
-      if (all(fz .eqv. frozen)) return
-      frozen = fz
-      call assembly_setup(model, asm, err, frozen, split_bodies())
-      call ls%new_pattern()
-    end subroutine update_frozen
+      if (all(fz .eqv. r%frozen)) return
+      r%frozen = fz
+      call assembly_setup(model, r%asm, r%err, r%frozen, r%ls%schur)
+      call r%ls%new_pattern()
+    end associate
+  end subroutine update_frozen
 
-    !> The ranks that factorise and solve body b's block (when every body is solved)
-    function ranks_of(b) result(str)
-      integer, intent(in) :: b
-      character(len=:), allocatable :: str
-      character(len=12) :: num
-      integer :: r
-      if (asm%ngroups == 1) then
-        str = 'all ranks, one instance'
-      else if (asm%group(b) < 0) then
-        str = 'all ranks, shared'
-      else
-        str = 'rank'
-        do r = asm%group(b), n_ranks - 1, asm%ngroups
-          write (num, '(i0)') r
-          str = str//' '//trim(num)
-        end do
-      end if
-    end function ranks_of
+  !> The ranks that factorise and solve body b's block (when every body is solved)
+  function ranks_of(r, b) result(str)
+    type(run_t), intent(in) :: r
+    integer, intent(in) :: b
+    character(len=:), allocatable :: str
+    character(len=12) :: num
+    integer :: k
+    if (r%asm%ngroups == 1) then
+      str = 'all ranks, one instance'
+    else if (r%asm%group(b) < 0) then
+      str = 'all ranks, shared'
+    else
+      str = 'rank'
+      do k = r%asm%group(b), n_ranks - 1, r%asm%ngroups
+        write (num, '(i0)') k
+        str = str//' '//trim(num)
+      end do
+    end if
+  end function ranks_of
 
-    !> K is block diagonal by body unless the constraints are factorised with it ('saddle')
-    logical function split_bodies()
-      split_bodies = ls%schur
-    end function split_bodies
+  !> The deck's contact (none: r%contact stays unallocated); K is block diagonal by body
+  !> unless the constraints are factorised with it ('saddle')
+  subroutine setup_contact(r)
+    type(run_t), intent(inout) :: r
+    logical :: use_contact
+    allocate (r%contact)
+    call scene_contact(r%deck, r%model, r%contact, use_contact)
+    if (.not. use_contact) deallocate (r%contact)
+    r%ls%schur = .not. use_contact .or. r%deck%contact%solver == 'schur'
+    if (use_contact .and. r%deck%run%analysis /= 'static') call mass_setup(r%model, r%ls%mass, r%err)
+  end subroutine setup_contact
 
-    subroutine setup_contact()
-      allocate (contact)
-      call scene_contact(deck, model, contact, use_contact)
-      if (.not. use_contact) deallocate (contact)
-      ls%schur = .not. use_contact .or. deck%contact%solver == 'schur'
-      if (use_contact .and. deck%run%analysis /= 'static') call mass_setup(model, ls%mass, err)
-    end subroutine setup_contact
-
-    !> Gravity's acceleration at the start, g on every point of a free body clear of contact
-    !> (restrained or resting bodies start at rest, a = 0: their supports hold them). With 0
-    !> for a falling body the first step would change its momentum by (gamma - 1/2) m g dt
-    !> too much (thesis Newmark: 3e-5 of a bouncing ring's momentum change). (Not M^-1 f for
-    !> nodal loads: concentrated at the loaded nodes, it made Newton diverge on a thin strip
-    !> under a point load.)
-    subroutine start_acceleration()
-      logical :: falls(model%nbody)
-      integer :: b, n
+  !> Gravity's acceleration at the start, g on every point of a free body clear of contact
+  !> (restrained or resting bodies start at rest, a = 0: their supports hold them). With 0
+  !> for a falling body the first step would change its momentum by (gamma - 1/2) m g dt
+  !> too much (thesis Newmark: 3e-5 of a bouncing ring's momentum change). (Not M^-1 f for
+  !> nodal loads: concentrated at the loaded nodes, it made Newton diverge on a thin strip
+  !> under a point load.)
+  subroutine start_acceleration(r)
+    type(run_t), intent(inout) :: r
+    logical :: falls(r%model%nbody)
+    integer :: b, n
+    associate (model => r%model, st => r%st)
       if (all(model%gravity == 0)) return
       falls = [(.not. any(model%fixed(dof(model%body(b)%node_first, 1):dof(model%body(b)%node_last, 7))), &
                 b=1, model%nbody)]
-      if (use_contact) call clear_near_contact(model, st%q, st%qd, deck%run%dt, contact, falls)
+      if (allocated(r%contact)) call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls)
       do b = 1, model%nbody
         if (.not. falls(b)) cycle
         do n = model%body(b)%node_first, model%body(b)%node_last
           st%qdd(dof(n, 1):dof(n, 3)) = model%gravity
         end do
       end do
-    end subroutine start_acceleration
+    end associate
+  end subroutine start_acceleration
 
-    !> the output folder and files; the history's per-body and per-pair columns are named
-    !> after the bodies and obstacles (targets -k: names from -size(obstacles) up)
-    subroutine open_history()
-      character(len=64), allocatable :: body_names(:)   ! (the deck's longest name)
-      character(len=:), allocatable :: pair_names(:)
-      logical :: friction
-      body_names = [character(len=64) :: (model%body(k)%name, k=1, model%nbody)]
+  !> the output folder and files; the history's per-body and per-pair columns are named
+  !> after the bodies and obstacles (targets -k: names from -size(obstacles) up)
+  subroutine open_history(r)
+    type(run_t), intent(inout) :: r
+    character(len=64), allocatable :: body_names(:), sides(:)   ! (the deck's longest name)
+    character(len=:), allocatable :: pair_names(:)
+    logical :: friction
+    integer :: k, no
+    associate (deck => r%deck, model => r%model)
+      allocate (body_names(model%nbody))
+      do k = 1, model%nbody
+        body_names(k) = model%body(k)%name
+      end do
       friction = .false.
       allocate (character(len=1) :: pair_names(0))
-      if (use_contact) then
-        friction = deck%run%analysis /= 'static' .and. (any(contact%mu_d > 0) .or. any(contact%mu_s > 0))
-        call pair_labels(contact%pair, [character(len=64) :: (deck%obstacles(-k)%name, &
-                         k=-size(deck%obstacles), -1), '-', body_names], -size(deck%obstacles), pair_names)
+      if (allocated(r%contact)) then
+        friction = deck%run%analysis /= 'static' .and. (any(r%contact%mu_d > 0) .or. any(r%contact%mu_s > 0))
+        no = size(deck%obstacles)
+        allocate (sides(no + 1 + model%nbody))   ! (sides -no .. nbody)
+        do k = 1, no
+          sides(k) = deck%obstacles(no + 1 - k)%name
+        end do
+        sides(no + 1) = '-'
+        sides(no + 2:) = body_names
+        call pair_labels(r%contact%pair, sides, -no, pair_names)
       end if
-      call output_open(out, dir, tracked, labels, body_names, pair_names, friction, &
-                       moving_obstacles(deck, use_contact), restart_step, st%t, err, folder_of(restart))
-    end subroutine open_history
+      call output_open(r%out, r%dir, r%tracked, r%labels, body_names, pair_names, friction, &
+                       moving_obstacles(deck, allocated(r%contact)), r%restart_step, r%st%t, r%err, &
+                       folder_of(r%restart))
+    end associate
+  end subroutine open_history
 
-    subroutine history_row(newton)
-      integer, intent(in) :: newton
-      real(dp) :: lmax
-      pen = 0; gmax = 0; lmax = 0
-      if (use_contact) then
-        call contact_penetration(contact, model, st%q, pen, gmax)
-        if (contact%nact > 0) lmax = maxval(contact%act(1:contact%nact)%lambda)
-        call output_history(out, st, bal, contact%nact, contact_force_total(contact), newton, &
-                            max(pen, 0._dp), rep%neg_pivots, lmax, gmax, &
-                            pair_normal_force(contact), pair_active_count(contact), &
-                            norm2(contact%impulse, dim=1), err, &
-                            pair_tangential_force(contact), sum(contact%friction_work), contact%obstacle_work)
-      else
-        call output_history(out, st, bal, 0, 0._dp, newton, 0._dp, rep%neg_pivots, 0._dp, 0._dp, &
-                            [real(dp) ::], [integer ::], [real(dp) ::], err)
-      end if
-    end subroutine history_row
+  subroutine history_row(r, newton)
+    type(run_t), intent(inout) :: r
+    integer, intent(in) :: newton
+    real(dp) :: lmax, pen, gmax
+    pen = 0; gmax = 0; lmax = 0
+    if (allocated(r%contact)) then
+      associate (c => r%contact)
+        call contact_penetration(c, r%model, r%st%q, pen, gmax)
+        if (c%nact > 0) lmax = maxval(c%act(1:c%nact)%lambda)
+        call output_history(r%out, r%st, r%bal, c%nact, contact_force_total(c), newton, &
+                            max(pen, 0._dp), r%rep%neg_pivots, lmax, gmax, &
+                            pair_normal_force(c), pair_active_count(c), norm2(c%impulse, dim=1), r%err, &
+                            pair_tangential_force(c), sum(c%friction_work), c%obstacle_work)
+      end associate
+    else
+      call output_history(r%out, r%st, r%bal, 0, 0._dp, newton, 0._dp, r%rep%neg_pivots, 0._dp, 0._dp, &
+                          [real(dp) ::], [integer ::], [real(dp) ::], r%err)
+    end if
+  end subroutine history_row
 
-    subroutine frame()
-      real(dp), allocatable :: fc(:, :), sd(:, :)
-      if (.not. deck%output%vtu) return
-      if (use_contact) then
-        allocate (fc(3, model%nnode), sd(1, model%nnode))
-        call contact_nodal_fields(contact, model, fc)
-        call contact_signed_distance(contact, model, st%q, sd(1, :))
-        call output_frame(out, model, st, [field('contact_force', fc), &
-                                           field('signed_distance', sd)], err)
-      else
-        call output_frame(out, model, st, [field_t ::], err)
-      end if
-    end subroutine frame
+  subroutine frame(r)
+    type(run_t), intent(inout) :: r
+    real(dp), allocatable :: fc(:, :), sd(:, :)
+    if (.not. r%deck%output%vtu) return
+    if (allocated(r%contact)) then
+      allocate (fc(3, r%model%nnode), sd(1, r%model%nnode))
+      call contact_nodal_fields(r%contact, r%model, fc)
+      call contact_signed_distance(r%contact, r%model, r%st%q, sd(1, :))
+      call output_frame(r%out, r%model, r%st, [field('contact_force', fc), &
+                                               field('signed_distance', sd)], r%err)
+    else
+      call output_frame(r%out, r%model, r%st, [field_t ::], r%err)
+    end if
+  end subroutine frame
 
-    logical function failed(what)
-      character(len=*), intent(in) :: what
-      call share_error(err)   ! collective: every rank stops with the same code
-      failed = allocated(err)
-      if (failed) then
-        if (is_root()) write (0, '(a,a,a,a)') 'error (', what, '): ', err%message
-        code = exit_solver
-        if (what == 'output' .or. what == 'setup' .or. what == 'restart') code = exit_input
-        call output_release(out)
-      end if
-    end function failed
+  !> r%err on any rank (collective: every rank stops with the same code): say what failed
+  logical function failed(r, what)
+    type(run_t), intent(inout) :: r
+    character(len=*), intent(in) :: what
+    call share_error(r%err)
+    failed = allocated(r%err)
+    if (failed) then
+      if (is_root()) write (0, '(a,a,a,a)') 'error (', what, '): ', r%err%message
+      r%code = exit_solver
+      if (what == 'output' .or. what == 'setup' .or. what == 'restart') r%code = exit_input
+      call output_release(r%out)
+    end if
+  end function failed
 
-    !> One line per frame: Newton iterations per step and the time left from the frame
-    !> interval just done (contact makes later steps dearer than the first ones: from the
-    !> start, a run that took 175 s had said 11 s left)
-    subroutine progress()
-      real(dp) :: now, rate
-      integer :: nc
+  !> One line per frame: Newton iterations per step and the time left from the frame
+  !> interval just done (contact makes later steps dearer than the first ones: from the
+  !> start, a run that took 175 s had said 11 s left)
+  subroutine progress(r)
+    type(run_t), intent(inout) :: r
+    real(dp) :: now, rate
+    integer :: nc
+    associate (st => r%st, last => r%last)
       now = wall_time()
       rate = (now - last%wall)/max(st%t - last%t, tiny(1._dp))
       nc = 0
-      if (use_contact) nc = contact%nact
+      if (allocated(r%contact)) nc = r%contact%nact
       print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
-        '  dt', nm%dt, '  newton/step', real(total_newton - last%newton)/max(st%step - last%step, 1), &
-        '  contacts', nc, '  elapsed', now - t0, ' s  left', rate*max(deck%run%t_end - st%t, 0._dp), ' s'
-      last = progress_t(now, st%t, st%step, total_newton)
-    end subroutine progress
+        '  dt', r%nm%dt, '  newton/step', real(r%total_newton - last%newton)/max(st%step - last%step, 1), &
+        '  contacts', nc, '  elapsed', now - r%t0, ' s  left', rate*max(r%deck%run%t_end - st%t, 0._dp), ' s'
+      last = progress_t(now, st%t, st%step, r%total_newton)
+    end associate
+  end subroutine progress
 
-    subroutine checkpoint()
-      type(error_t), allocatable :: e
-      call ls%drop_factors()   ! on every rank: a restart from here starts with new factors
-      call output_flush(out, e)   ! the history up to this step, for a restart from here
-      if (.not. allocated(e)) call save_checkpoint(dir//'/checkpoint.h5', model, st, level, contact, e)
-      call share_error(e)
-      if (allocated(e)) then
-        if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message
-        code = exit_solver
-        call output_release(out)
-      end if
-    end subroutine checkpoint
+  subroutine checkpoint(r)
+    type(run_t), intent(inout) :: r
+    type(error_t), allocatable :: e
+    call r%ls%drop_factors()   ! on every rank: a restart from here starts with new factors
+    call output_flush(r%out, e)   ! the history up to this step, for a restart from here
+    if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e)
+    call share_error(e)
+    if (allocated(e)) then
+      if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message
+      r%code = exit_solver
+      call output_release(r%out)
+    end if
+  end subroutine checkpoint
 
-    !> The solver cannot go on: keep the last good state (frame and checkpoint) and stop.
-    subroutine give_up(why)
-      character(len=*), intent(in) :: why
-      type(error_t), allocatable :: e
-      if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', st%t, &
-        ' s: ', why
-      call frame()
-      call checkpoint()
-      call ls%finish()
-      call output_close(out, e)
-      if (is_root()) write (0, '(a)') 'the last good state is in '//dir// &
-        '/checkpoint.h5 (restart with --restart) and in the last frame of '//dir//'/run.pvd'
-      ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
-      ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
-      if (is_root() .and. nm%gamma <= 0.5_dp .and. deck%run%analysis /= 'static') write (0, '(a)') &
-        'hint: gamma = 0.5 keeps the shells'' fastest vibrations undamped, which can stall Newton; '// &
-        'beta = 0.3025, gamma = 0.6 damps them (or the thesis'' beta = 1, gamma = 1.5)'
-      code = exit_solver
-    end subroutine give_up
+  !> The solver cannot go on: keep the last good state (frame and checkpoint) and stop.
+  subroutine give_up(r, why)
+    type(run_t), intent(inout) :: r
+    character(len=*), intent(in) :: why
+    type(error_t), allocatable :: e
+    if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', r%st%t, &
+      ' s: ', why
+    call frame(r)
+    call checkpoint(r)
+    call r%ls%finish()
+    call output_close(r%out, e)
+    if (is_root()) write (0, '(a)') 'the last good state is in '//r%dir// &
+      '/checkpoint.h5 (restart with --restart) and in the last frame of '//r%dir//'/run.pvd'
+    ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
+    ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
+    if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') write (0, '(a)') &
+      'hint: gamma = 0.5 keeps the shells'' fastest vibrations undamped, which can stall Newton; '// &
+      'beta = 0.3025, gamma = 0.6 damps them (or the thesis'' beta = 1, gamma = 1.5)'
+    r%code = exit_solver
+  end subroutine give_up
 
-    subroutine finish()
-      type(error_t), allocatable :: e
-      call ls%finish()
-      call output_close(out, e)
-      call share_error(e)
-      if (allocated(e)) then
-        if (is_root()) write (0, '(a,a)') 'error (output): ', e%message
-        code = exit_solver; return
+  !> Close the files, draw the plots, print the summary (and, for a dynamic run from t = 0,
+  !> what it kept and the energy balance)
+  subroutine finish(r)
+    type(run_t), intent(inout) :: r
+    type(error_t), allocatable :: e
+    logical :: missing
+    call r%ls%finish()
+    call output_close(r%out, e)
+    call share_error(e)
+    if (allocated(e)) then
+      if (is_root()) write (0, '(a,a)') 'error (output): ', e%message
+      r%code = exit_solver; return
+    end if
+    if (r%deck%output%plots .and. is_root()) then
+      call make_plots(r%dir, e, missing)
+      if (allocated(e)) write (0, '(a,a)') 'warning: plots: ', e%message
+      if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//r%dir// &
+        '/plots.gp was written but not run'
+    end if
+    if (.not. is_root() .or. r%quiet) return
+    associate (deck => r%deck, model => r%model)
+      print '(a)', 'done: '//count_of(r%st%step, 'step', 'steps')//' in '//seconds(wall_time() - r%t0)// &
+        ' s; results in '//r%dir
+      print '(a)', timer_report(wall_time() - r%t0)
+      if (deck%run%analysis /= 'static' .and. r%restart_step < 0) then
+        print '(a)', balance_summary(r%bal0, r%bal, model%length, any(model%fixed) .or. &
+                                     any(r%fext /= 0) .or. size(deck%obstacles) > 0)
+        print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact))
       end if
-      if (deck%output%plots .and. is_root()) then
-        call make_plots(dir, e, missing)
-        if (allocated(e)) write (0, '(a,a)') 'warning: plots: ', e%message
-        if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//dir// &
-          '/plots.gp was written but not run'
-      end if
-      if (is_root() .and. .not. quiet) then
-        print '(a,i0,a,a,a,a)', 'done: ', st%step, ' steps in ', seconds(wall_time() - t0), &
-          ' s; results in ', dir
-        print '(a)', timer_report(wall_time() - t0)
-        if (deck%run%analysis /= 'static' .and. restart_step < 0) then
-          print '(a)', balance_summary(bal0, bal, model%length, any(model%fixed) .or. &
-                                       any(fext /= 0) .or. any(fgrav /= 0) .or. size(deck%obstacles) > 0)
-          print '(a)', energy_balance(bal0, bal, balance_terms(deck, contact))
-        end if
-      end if
-    end subroutine finish
-
-    !> Statics: load steps of the dead loads; one history row and frame per load step
-    !> (t = load factor).
-    subroutine static_run()
-      integer :: i
-      do i = 1, deck%run%load_steps
-        call static_solve(model, asm, ls, fext, st%t, real(i, dp)/deck%run%load_steps, &
-                          deck%run%max_step_cuts, opts, st%q, rep, err, contact)
-        if (allocated(err)) then
-          call give_up(err%message); return
-        end if
-        st%t = real(i, dp)/deck%run%load_steps; st%step = i
-        call account(model, asm, st, fext*st%t, q0, bal)
-        call history_row(rep%iters)
-        if (failed('history')) return
-        call frame()
-        if (failed('frame')) return
-        if (is_root() .and. .not. quiet) print '(a,i4,a,f6.3,a,i3)', 'load step', i, &
-          '  factor', st%t, '  newton', rep%iters
-      end do
-      call checkpoint()
-      call finish()
-    end subroutine static_run
-  end subroutine run_deck
+    end associate
+  end subroutine finish
   !> The energy balance's terms that the scene has: friction's, moving obstacles'
   function balance_terms(deck, contact) result(terms)
     type(deck_t), intent(in) :: deck
