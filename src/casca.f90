@@ -169,6 +169,7 @@ contains
         '  tracked.txt                 a label per tracked node', &
         '  checkpoint.h5               the state at the last checkpoint (for --restart)', &
         '  plots.gp, *.png             time-history plots (gnuplot), unless &output plots = .false.', &
+        '  gnuplot.log                 gnuplot''s messages', &
         '  casca.lock                  while it runs: no second run writes into the folder', &
         'exit codes: 0 done, 2 bad input (every problem of the deck listed), 3 the solver could', &
         '  not go on or an output could not be written (the last good state is kept)']
@@ -207,7 +208,8 @@ contains
         '', &
         'Reads DIR/history.dat (and DIR/tracked.txt), writes DIR/plots.gp and runs gnuplot on it', &
         'in DIR: positions_x|y|z.png, displacements.png, energy.png, momentum.png, contact.png,', &
-        'newton.png. Edit plots.gp and re-run gnuplot plots.gp in DIR to change them.', &
+        'newton.png; gnuplot''s messages go to DIR/gnuplot.log. Edit plots.gp and re-run', &
+        'gnuplot plots.gp in DIR to change them.', &
         'options:', &
         '  -h, --help        this text', &
         'exit codes: 0 plots written, 2 no readable history or gnuplot missing (plots.gp kept)']

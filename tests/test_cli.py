@@ -12,7 +12,11 @@ Asserted about the command line itself (issue 17):
   and MUMPS/METIS/HDF5 equal to the versions in the system headers dmumps_c.h, metis.h and
   H5public.h where those are found; under `mpirun -np 2` exit 0 and printed once;
 - plurals: `casca check` of a one-body deck says "1 body," (never "1 bodies"), of a two-body
-  deck "2 bodies,"; `casca mesh` says "N elements, M nodes".
+  deck "2 bodies,"; `casca mesh` says "N elements, M nodes";
+- gnuplot's messages stay off the terminal: `casca run` of the static cantilever example (flat
+  energy curves, on which gnuplot warns "empty y range") and `casca plot` of its folder exit 0
+  with no "empty y range" in their stdout or stderr, and the warning is in the folder's
+  gnuplot.log instead (so the scene does provoke it).
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -262,6 +266,19 @@ for f in glob.glob(os.path.join(work, "replot", "*.png")):
 p = run([casca, "plot", os.path.join(work, "replot")])
 ck.record("casca plot DIR remakes the plots", p.returncode == 0 and
           os.path.exists(os.path.join(work, "replot", "positions_x.png")))
+
+# --- gnuplot's warnings go to DIR/gnuplot.log, not the terminal
+out_c = os.path.join(work, "cantilever_out")
+shutil.rmtree(out_c, ignore_errors=True)
+p = run([casca, "run", os.path.join(examples, "cantilever.nml"), "--out", out_c, "-q"])
+log = os.path.join(out_c, "gnuplot.log")
+ck.record("static cantilever run: exit 0, no 'empty y range' on the terminal",
+          p.returncode == 0 and "empty y range" not in p.stdout + p.stderr, (p.stdout + p.stderr)[-300:])
+ck.record("gnuplot's 'empty y range' warning is in DIR/gnuplot.log",
+          os.path.exists(log) and "empty y range" in open(log).read())
+p = run([casca, "plot", out_c])
+ck.record("casca plot of it: exit 0, no 'empty y range' on the terminal",
+          p.returncode == 0 and "empty y range" not in p.stdout + p.stderr, (p.stdout + p.stderr)[-300:])
 
 # --- restart: a run stopped at 1.5 ms and continued equals the uninterrupted run (both write
 # a checkpoint at 1.5 ms: the step after a checkpoint starts with a new factorisation)
