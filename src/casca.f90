@@ -1,11 +1,28 @@
 !> casca: impact between elastic shell structures (positional shell FEM, Newmark,
 !> signed-distance contact with Lagrange multipliers). The command line picks one of
-!> run / check / mesh / plot.
+!> run / check / mesh / plot; `casca COMMAND --help` tells each one's options.
+!>
+!> Preprocessed (cpp) for the build facts of casca --version: CMake defines CASCA_BUILD_INFO
+!> and generates casca_build_info.h at every build (the git commit, the build type); other
+!> builds (fpm) fall back to 'unknown'.
+#ifdef CASCA_BUILD_INFO
+#include "casca_build_info.h"
+#endif
+#ifndef CASCA_GIT_COMMIT
+#define CASCA_GIT_COMMIT "unknown"
+#endif
+#ifndef CASCA_BUILD_TYPE
+#define CASCA_BUILD_TYPE "unknown"
+#endif
 program casca
   use, intrinsic :: iso_c_binding, only: c_int
+  use, intrinsic :: iso_fortran_env, only: compiler_version
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_mpi, only: mpi_start, mpi_stop, is_root, max_all
+  use casca_strings, only: count_of, itoa
+  use casca_mpi, only: mpi_start, mpi_stop, is_root, max_all, mpi_version
+  use casca_mumps_solver, only: mumps_version
+  use casca_hdf5_io, only: hdf5_version
   use casca_run, only: run_deck, load_scene, exit_ok, exit_input
   use casca_deck, only: deck_t
   use casca_model, only: model_t
@@ -20,9 +37,17 @@ program casca
       import :: c_int
       integer(c_int), value :: status
     end subroutine c_exit
+    !> metis.h's version numbers (src/solve/metis_check.c)
+    subroutine metis_version_c(major, minor, subminor) bind(c, name='casca_metis_version')
+      import :: c_int
+      integer(c_int), intent(out) :: major, minor, subminor
+    end subroutine metis_version_c
   end interface
 
   character(len=*), parameter :: version = '0.1.0'
+  character(len=*), parameter :: commands(4) = [character(len=5) :: 'run', 'check', 'mesh', 'plot']
+  !> width of a line of help text
+  integer, parameter :: hw = 100
   character(len=:), allocatable :: cmd
   integer :: code
 
@@ -39,9 +64,19 @@ program casca
   case ('plot')
     call cmd_plot()
   case ('--version', '-V')
-    if (is_root()) print '(a)', 'casca '//version
-  case ('--help', '-h', 'help')
+    call print_version()
+  case ('--help', '-h')
     call usage(6)
+  case ('help')   ! casca help [COMMAND]
+    if (command_argument_count() < 2) then
+      call usage(6)
+    else if (any(commands == arg(2))) then
+      call command_help(arg(2))
+    else
+      if (is_root()) write (0, '(a)') 'error: help: unknown command "'//arg(2)// &
+        '" (commands: run, check, mesh, plot)'
+      code = exit_input
+    end if
   case ('')
     call usage(0); code = exit_input
   case default
@@ -63,26 +98,152 @@ contains
     if (n > 0) call get_command_argument(i, s)
   end function arg
 
+  !> casca --help: every command's synopsis, as its own help text gives it
   subroutine usage(u)
     integer, intent(in) :: u
+    character(len=hw), allocatable :: t(:)
+    integer :: c, k
     if (.not. is_root()) return
-    write (u, '(a)') 'casca '//version//': impact between elastic shell structures', &
-      '', 'usage:', &
-      '  casca run DECK [--out DIR] [--restart FILE] [-q]   run a deck (also under mpirun -np N)', &
-      '  casca check DECK                                 check a deck without running it', &
-      '  casca mesh ring   --radius R --width W --n-around N --n-across M -o FILE.msh', &
-      '  casca mesh sphere --radius R --n-div N -o FILE.msh', &
-      '  casca mesh plate|strip --lx A --ly B --nx N --ny M -o FILE.msh', &
-      '  casca plot DIR                                   (re)make the plots of a finished run', &
+    write (u, '(a)') 'casca '//version//': impact between elastic shell structures', '', 'usage:'
+    do c = 1, size(commands)
+      t = help_text(trim(commands(c)))
+      do k = 1, size(t)
+        if (t(k) == '') exit
+        write (u, '(a)') '  '//trim(t(k))
+      end do
+    end do
+    write (u, '(a)') '  casca COMMAND --help                               the options of a command', &
       '  casca --help | --version', &
       '', 'exit codes: 0 done, 2 bad input, 3 the solver could not go on (last state kept)'
   end subroutine usage
+
+  !> casca COMMAND --help (and casca help COMMAND): the command's whole help text, on stdout
+  subroutine command_help(cmd)
+    character(len=*), intent(in) :: cmd
+    character(len=hw), allocatable :: t(:)
+    integer :: k
+    logical :: synopsis
+    if (.not. is_root()) return
+    t = help_text(cmd)
+    write (6, '(a)') 'usage:'
+    synopsis = .true.
+    do k = 1, size(t)
+      if (t(k) == '') synopsis = .false.
+      if (synopsis) then
+        write (6, '(a)') '  '//trim(t(k))
+      else
+        write (6, '(a)') trim(t(k))
+      end if
+    end do
+  end subroutine command_help
+
+  !> True if -h or --help is among the command's arguments (after the command's name)
+  logical function wants_help()
+    integer :: i
+    wants_help = .false.
+    do i = 2, command_argument_count()
+      if (arg(i) == '-h' .or. arg(i) == '--help') wants_help = .true.
+    end do
+  end function wants_help
+
+  !> The one help text of each command: its synopsis lines up to the first blank line (what
+  !> casca --help lists), then what it does, its options and what it writes.
+  function help_text(cmd) result(t)
+    character(len=*), intent(in) :: cmd
+    character(len=hw), allocatable :: t(:)
+    select case (cmd)
+    case ('run')
+      t = [character(len=hw) :: &
+        'casca run DECK [--out DIR] [--restart FILE] [-q]   run a deck (also under mpirun -np N)', &
+        '', &
+        'Runs the scene of the namelist deck DECK (its mesh files are relative to the deck).', &
+        'options:', &
+        '  -o, --out DIR     output folder (default: dir of the deck''s &output, else out;', &
+        '                    relative to the current folder)', &
+        '  --restart FILE    continue from a checkpoint of the same model (DIR/checkpoint.h5)', &
+        '  -q, --quiet       no progress lines and no closing summary (errors still shown)', &
+        '  -h, --help        this text', &
+        'writes in the output folder:', &
+        '  run.pvd, frame_NNNNN.vtu    ParaView frames with their times', &
+        '  history.dat, history.h5     one row per step: energies, momenta, contacts, tracked nodes', &
+        '  tracked.txt                 a label per tracked node', &
+        '  checkpoint.h5               the state at the last checkpoint (for --restart)', &
+        '  plots.gp, *.png             time-history plots (gnuplot), unless &output plots = .false.', &
+        '  gnuplot.log                 gnuplot''s messages', &
+        '  casca.lock                  while it runs: no second run writes into the folder', &
+        'exit codes: 0 done, 2 bad input (every problem of the deck listed), 3 the solver could', &
+        '  not go on or an output could not be written (the last good state is kept)']
+    case ('check')
+      t = [character(len=hw) :: &
+        'casca check DECK                                   check a deck without running it', &
+        '', &
+        'Reads DECK and builds its scene: prints the number of bodies, elements, nodes and', &
+        'unknowns, and for each contact pair its initial gap and time to contact at the', &
+        'initial velocities. Every problem of the deck is listed with its file, line and field.', &
+        'Writes no file.', &
+        'options:', &
+        '  -h, --help        this text', &
+        'exit codes: 0 the deck can run, 2 it has problems']
+    case ('mesh')
+      t = [character(len=hw) :: &
+        'casca mesh ring   --radius R --width W --n-around N --n-across M -o FILE.msh', &
+        'casca mesh sphere --radius R --n-div N -o FILE.msh', &
+        'casca mesh plate|strip --lx A --ly B --nx N --ny M -o FILE.msh', &
+        '', &
+        'Writes a mesh of 10-node (cubic) triangles to FILE.msh (Gmsh MSH 4.1) for a deck''s', &
+        '&body mesh = ''file''. Sizes in m; each grid cell is two triangles.', &
+        '  ring     cylindrical strip, axis z, mid-surface radius R (1), width W (0.2) along z,', &
+        '           N (20) cells around and M (1) across', &
+        '  sphere   sphere of radius R (1) about the origin: 20 N^2 triangles, N (6) per', &
+        '           icosahedron edge', &
+        '  plate    rectangle [0,A] x [0,B] (1 x 1) in the xy plane, N (4) by M (1) cells;', &
+        '  strip    the same', &
+        'options:', &
+        '  -o, --out FILE    the mesh file to write (required)', &
+        '  -h, --help        this text', &
+        'exit codes: 0 written, 2 bad input']
+    case ('plot')
+      t = [character(len=hw) :: &
+        'casca plot DIR                                     (re)make the plots of a finished run', &
+        '', &
+        'Reads DIR/history.dat (and DIR/tracked.txt), writes DIR/plots.gp and runs gnuplot on it', &
+        'in DIR: positions_x|y|z.png, displacements.png, energy.png, momentum.png, contact.png,', &
+        'newton.png; gnuplot''s messages go to DIR/gnuplot.log. Edit plots.gp and re-run', &
+        'gnuplot plots.gp in DIR to change them.', &
+        'options:', &
+        '  -h, --help        this text', &
+        'exit codes: 0 plots written, 2 no readable history or gnuplot missing (plots.gp kept)']
+    case default
+      allocate (t(0))
+    end select
+  end function help_text
+
+  !> casca --version: casca's version and build, and the versions of the libraries it was
+  !> built with (MUMPS starts an instance, collectively: every rank takes part)
+  subroutine print_version()
+    character(len=:), allocatable :: mumps
+    integer(c_int) :: major, minor, subminor
+    mumps = mumps_version()
+    call metis_version_c(major, minor, subminor)
+    if (.not. is_root()) return
+    write (6, '(a)') 'casca '//version, &
+      'commit:   '//CASCA_GIT_COMMIT, &
+      'build:    '//CASCA_BUILD_TYPE, &
+      'compiler: '//compiler_version(), &
+      'MPI:      '//mpi_version(), &
+      'MUMPS:    '//mumps, &
+      'HDF5:     '//hdf5_version(), &
+      'METIS:    '//itoa(int(major))//'.'//itoa(int(minor))//'.'//itoa(int(subminor))
+  end subroutine print_version
 
   subroutine cmd_run()
     character(len=:), allocatable :: deck, out, restart, a
     logical :: quiet
     integer :: i
     deck = ''; out = ''; restart = ''; quiet = .false.
+    if (wants_help()) then
+      call command_help('run'); return
+    end if
     i = 2
     do while (i <= command_argument_count())
       a = arg(i)
@@ -117,14 +278,18 @@ contains
   subroutine cmd_check()
     type(deck_t) :: deck
     type(model_t) :: model
+    if (wants_help()) then
+      call command_help('check'); return
+    end if
     if (command_argument_count() /= 2) then
-      if (is_root()) write (0, '(a)') 'error: check: usage: casca check DECK'
+      if (is_root()) write (0, '(a)') 'error: check: usage: casca check DECK (see casca check --help)'
       code = exit_input; return
     end if
     call load_scene(arg(2), deck, model, code, gaps=.true.)
-    if (code == exit_ok .and. is_root()) print '(a,i0,a,i0,a,i0,a,i0,a)', arg(2)//': ok: ', &
-      model%nbody, ' bodies, ', model%nelem, ' elements, ', model%nnode, ' nodes, ', &
-      count(.not. model%fixed), ' unknowns'
+    if (code == exit_ok .and. is_root()) print '(a)', arg(2)//': ok: '// &
+      count_of(model%nbody, 'body', 'bodies')//', '//count_of(model%nelem, 'element', 'elements')// &
+      ', '//count_of(model%nnode, 'node', 'nodes')//', '// &
+      count_of(count(.not. model%fixed), 'unknown', 'unknowns')
   end subroutine cmd_check
 
   subroutine cmd_mesh()
@@ -133,6 +298,9 @@ contains
     character(len=:), allocatable :: kind, out, key, val
     real(dp) :: radius, width, lx, ly
     integer :: n_around, n_across, n_div, nx, ny, i, ios
+    if (wants_help()) then
+      call command_help('mesh'); return
+    end if
     kind = arg(2); out = ''
     radius = 1; width = 0.2_dp; lx = 1; ly = 1; n_around = 20; n_across = 1; n_div = 6
     nx = 4; ny = 1
@@ -187,14 +355,18 @@ contains
       if (is_root()) write (0, '(a)') 'error: mesh: '//err%message
       code = exit_input; return
     end if
-    if (is_root()) print '(a,i0,a,i0,a)', out//': ', mesh%nelem, ' elements, ', mesh%nnode, ' nodes'
+    if (is_root()) print '(a)', out//': '//count_of(mesh%nelem, 'element', 'elements')//', '// &
+      count_of(mesh%nnode, 'node', 'nodes')
   end subroutine cmd_mesh
 
   subroutine cmd_plot()
     type(error_t), allocatable :: err
     logical :: missing
+    if (wants_help()) then
+      call command_help('plot'); return
+    end if
     if (command_argument_count() /= 2) then
-      if (is_root()) write (0, '(a)') 'error: plot: usage: casca plot DIR'
+      if (is_root()) write (0, '(a)') 'error: plot: usage: casca plot DIR (see casca plot --help)'
       code = exit_input; return
     end if
     if (.not. is_root()) return

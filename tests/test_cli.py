@@ -1,11 +1,31 @@
 """The command line, the deck checks and the output files (issue: scenes in, results out).
 
+Asserted about the command line itself (issue 17):
+- `casca run|check|mesh|plot --help` and `-h`: exit 0, nothing on stderr, stdout begins with
+  "usage:" and names the command (`casca run ...`); `casca help CMD` prints the same text;
+  `casca help nosuch` exits 2 naming it;
+- `casca --help` holds each command's synopsis lines exactly as that command's own help
+  prints them (one text, reused);
+- `casca --version`: exit 0 without mpirun; lines commit (equal to `git rev-parse` of the
+  source tree's HEAD, with -dirty allowed, when the source is a git checkout), build, compiler
+  (GCC and the gfortran --version number), MPI, MUMPS, HDF5, METIS each with an x.y.z version,
+  and MUMPS/METIS/HDF5 equal to the versions in the system headers dmumps_c.h, metis.h and
+  H5public.h where those are found; under `mpirun -np 2` exit 0 and printed once;
+- plurals: `casca check` of a one-body deck says "1 body," (never "1 bodies"), of a two-body
+  deck "2 bodies,"; `casca mesh` says "N elements, M nodes";
+- gnuplot's messages stay off the terminal: `casca run` of the static cantilever example (flat
+  energy curves, on which gnuplot warns "empty y range") and `casca plot` of its folder exit 0
+  with no "empty y range" in their stdout or stderr, and the warning is in the folder's
+  gnuplot.log instead (so the scene does provoke it).
+Then the deck checks and a short run's output files (see the checks' names).
+
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
 """
 import glob
 import os
 import re
 import shutil
+import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
@@ -24,6 +44,77 @@ p = run([casca, "--help"])
 ck.record("casca --help: exit 0 and usage", p.returncode == 0 and "casca run DECK" in p.stdout)
 p = run([casca, "--version"])
 ck.record("casca --version", p.returncode == 0 and re.match(r"casca \d+\.\d+\.\d+", p.stdout) is not None)
+
+# --- help of each command: one text, printed by COMMAND --help, COMMAND -h and help COMMAND
+top = run([casca, "--help"]).stdout
+for cmd in ("run", "check", "mesh", "plot"):
+    texts = []
+    for flag in ("--help", "-h"):
+        p = run([casca, cmd, flag])
+        ok = (p.returncode == 0 and p.stderr == "" and p.stdout.startswith("usage:\n")
+              and ("  casca %s " % cmd) in p.stdout)
+        ck.record("casca %s %s: exit 0, its usage on stdout" % (cmd, flag), ok,
+                  "exit %d, stderr %r" % (p.returncode, p.stderr[:120]))
+        texts.append(p.stdout)
+    p = run([casca, "help", cmd])
+    ck.record("casca help %s prints the same text as casca %s --help" % (cmd, cmd),
+              p.returncode == 0 and p.stdout == texts[0] == texts[1])
+    synopsis = texts[0].split("\n\n")[0].splitlines()[1:]
+    ck.record("casca --help holds the synopsis of casca %s --help (%d lines)" % (cmd, len(synopsis)),
+              len(synopsis) > 0 and all(line in top.splitlines() for line in synopsis))
+p = run([casca, "help", "nosuch"])
+ck.record("casca help nosuch: exit 2 naming it", p.returncode == 2 and '"nosuch"' in p.stderr)
+
+# --- version: casca's build and the libraries it was built with
+p = run([casca, "--version"])
+ver = dict(l.split(":", 1) for l in p.stdout.splitlines()[1:] if ":" in l)
+ver = {k.strip(): v.strip() for k, v in ver.items()}
+xyz = re.compile(r"\d+\.\d+\.\d+")
+ck.record("casca --version: exit 0, nothing on stderr, the 7 lines",
+          p.returncode == 0 and p.stderr == "" and
+          set(ver) == {"commit", "build", "compiler", "MPI", "MUMPS", "HDF5", "METIS"}, "%s; %s" % (sorted(ver), p.stderr[-200:]))
+for lib in ("MPI", "MUMPS", "HDF5", "METIS"):
+    ck.record("casca --version: %s has a version number" % lib, xyz.search(ver.get(lib, "")) is not None,
+              ver.get(lib, "(missing)"))
+gf = subprocess.run(["gfortran", "--version"], capture_output=True, text=True).stdout
+gfv = xyz.search(gf.splitlines()[0]) if gf else None
+if gfv:
+    ck.record("casca --version: compiler is GCC %s (gfortran --version)" % gfv.group(0),
+              ver.get("compiler", "").startswith("GCC") and gfv.group(0) in ver.get("compiler", ""),
+              ver.get("compiler", ""))
+src = os.path.dirname(examples)
+head = subprocess.run(["git", "-C", src, "rev-parse", "HEAD"], capture_output=True, text=True)
+if head.returncode == 0:
+    c = ver.get("commit", "")
+    short = c[:-len("-dirty")] if c.endswith("-dirty") else c
+    ck.record("casca --version: commit is the source tree's HEAD (%s)" % head.stdout.strip()[:12],
+              len(short) >= 7 and head.stdout.strip().startswith(short), c)
+ck.record("casca --version: build type named", ver.get("build", "") in ("Release", "Debug", "RelWithDebInfo",
+                                                                       "MinSizeRel"), ver.get("build", ""))
+for lib, header, pattern in (
+        ("MUMPS", "/usr/include/dmumps_c.h", r'#define MUMPS_VERSION "([^"]+)"'),
+        ("METIS", "/usr/include/metis.h", r"METIS_VER_MAJOR\s+(\d+).*?METIS_VER_MINOR\s+(\d+).*?METIS_VER_SUBMINOR\s+(\d+)"),
+        ("HDF5", "/usr/include/hdf5/openmpi/H5public.h", r'#define H5_VERS_INFO\s+"HDF5 library version: ([\d.]+)')):
+    if os.path.exists(header):
+        m = re.search(pattern, open(header).read(), re.S)
+        if m:
+            want = ".".join(m.groups())
+            ck.record("casca --version: %s %s as in %s" % (lib, want, header), ver.get(lib) == want, ver.get(lib, ""))
+p = run([casca, "--version"], np_ranks=2)
+ck.record("mpirun -np 2 casca --version: exit 0, printed once",
+          p.returncode == 0 and p.stdout.count("casca ") == 1 and "MUMPS:" in p.stdout, p.stderr[-200:])
+
+# --- counts with the noun in the number they ask for
+p = run([casca, "check", os.path.join(examples, "cantilever.nml")])
+ck.record("casca check of a one-body deck: '1 body,'", p.returncode == 0 and ": ok: 1 body, " in p.stdout
+          and "1 bodies" not in p.stdout, p.stdout.strip()[:200])
+p = run([casca, "check", os.path.join(examples, "two_rings.nml")])
+ck.record("casca check of a two-body deck: '2 bodies,'", p.returncode == 0 and ": ok: 2 bodies, " in p.stdout,
+          p.stdout.strip()[:200])
+p = run([casca, "mesh", "plate", "--nx", "1", "--ny", "1", "-o", os.path.join(work, "one_cell.msh")])
+ck.record("casca mesh: '2 elements, 16 nodes'", p.returncode == 0 and
+          p.stdout.strip().endswith(": 2 elements, 16 nodes"), p.stdout.strip())
+
 p = run([casca, "frobnicate"])
 ck.record("unknown command: exit 2", p.returncode == 2 and "unknown command" in p.stderr)
 p = run([casca, "run"])
@@ -175,6 +266,19 @@ for f in glob.glob(os.path.join(work, "replot", "*.png")):
 p = run([casca, "plot", os.path.join(work, "replot")])
 ck.record("casca plot DIR remakes the plots", p.returncode == 0 and
           os.path.exists(os.path.join(work, "replot", "positions_x.png")))
+
+# --- gnuplot's warnings go to DIR/gnuplot.log, not the terminal
+out_c = os.path.join(work, "cantilever_out")
+shutil.rmtree(out_c, ignore_errors=True)
+p = run([casca, "run", os.path.join(examples, "cantilever.nml"), "--out", out_c, "-q"])
+log = os.path.join(out_c, "gnuplot.log")
+ck.record("static cantilever run: exit 0, no 'empty y range' on the terminal",
+          p.returncode == 0 and "empty y range" not in p.stdout + p.stderr, (p.stdout + p.stderr)[-300:])
+ck.record("gnuplot's 'empty y range' warning is in DIR/gnuplot.log",
+          os.path.exists(log) and "empty y range" in open(log).read())
+p = run([casca, "plot", out_c])
+ck.record("casca plot of it: exit 0, no 'empty y range' on the terminal",
+          p.returncode == 0 and "empty y range" not in p.stdout + p.stderr, (p.stdout + p.stderr)[-300:])
 
 # --- restart: a run stopped at 1.5 ms and continued equals the uninterrupted run (both write
 # a checkpoint at 1.5 ms: the step after a checkpoint starts with a new factorisation)

@@ -4,13 +4,14 @@ module casca_mpi
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_SUM, &
                      MPI_MIN, MPI_MAX, MPI_CHARACTER, mpi_init, mpi_finalize, mpi_comm_rank, &
                      mpi_comm_size, mpi_initialized, mpi_finalized, mpi_wtime, mpi_allreduce, &
-                     mpi_bcast, mpi_comm_split, mpi_comm_free
+                     mpi_bcast, mpi_comm_split, mpi_comm_free, mpi_get_library_version, &
+                     MPI_MAX_LIBRARY_VERSION_STRING
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   implicit none
   private
   public :: mpi_start, mpi_stop, comm, comm_handle, group_handle, my_rank, n_ranks, is_root
-  public :: wall_time, sum_all, bcast_real, bcast_int, share_error, max_all
+  public :: wall_time, sum_all, bcast_real, bcast_int, share_error, max_all, mpi_version
 
   type(MPI_Comm), protected :: comm
   integer, protected :: my_rank = 0
@@ -101,6 +102,24 @@ contains
     call mpi_bcast(msg, length(1), MPI_CHARACTER, first(1), comm, ierr)
     if (my_rank /= first(1)) call fatal_error(err, msg)
   end subroutine share_error
+
+  !> The MPI library's own version line (casca --version), e.g. "Open MPI v4.1.4, package: ...";
+  !> only its first line (MPICH's runs over several). Needs no mpi_start.
+  function mpi_version() result(s)
+    character(len=:), allocatable :: s
+    character(len=MPI_MAX_LIBRARY_VERSION_STRING) :: b
+    integer :: n, ierr, k
+    b = ''
+    call mpi_get_library_version(b, n, ierr)
+    if (ierr /= 0) then
+      s = 'unknown'
+      return
+    end if
+    n = max(0, min(n, len(b)))
+    k = index(b(1:n), new_line('a'))
+    if (k > 0) n = k - 1
+    s = trim(b(1:n))
+  end function mpi_version
 
   logical function is_root()
     is_root = my_rank == 0

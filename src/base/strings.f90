@@ -3,7 +3,7 @@ module casca_strings
   use, intrinsic :: iso_fortran_env, only: int32, int64, real64
   implicit none
   private
-  public :: itoa, rtoa
+  public :: itoa, rtoa, count_of
 
   !> n as its shortest decimal text (default and 64-bit integers, e.g. HDF5's hsize_t)
   interface itoa
@@ -34,4 +34,17 @@ contains
     write (b, '(es12.4)') x
     s = trim(adjustl(b))
   end function rtoa
+
+  !> n and the noun in the number n asks for: count_of(1, 'body', 'bodies') is '1 body',
+  !> count_of(3, 'body', 'bodies') is '3 bodies' (0 takes the plural)
+  pure function count_of(n, one, many) result(s)
+    integer, intent(in) :: n
+    character(len=*), intent(in) :: one, many
+    character(len=:), allocatable :: s
+    if (n == 1) then
+      s = itoa_i32(n)//' '//one
+    else
+      s = itoa_i32(n)//' '//many
+    end if
+  end function count_of
 end module casca_strings

@@ -37,7 +37,7 @@ module casca_hdf5_io
                   h5tset_size_f, h5tset_strpad_f, h5tclose_f, H5T_NATIVE_CHARACTER, &
                   H5T_STR_NULLPAD_F, H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_IEEE_F64LE, &
                   H5T_STD_I32LE, h5lexists_f, H5P_FILE_ACCESS_F, h5pset_fapl_core_f, &
-                  h5fget_file_image_f
+                  h5fget_file_image_f, h5get_libversion_f
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_checked_file, only: write_file_atomic
@@ -45,7 +45,7 @@ module casca_hdf5_io
   implicit none
   private
   public :: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, h5_table_close, &
-            h5_table_open_append, h5_table_nrow, write_checkpoint, read_checkpoint
+            h5_table_open_append, h5_table_nrow, write_checkpoint, read_checkpoint, hdf5_version
 
   !> An open history table (opaque). Default-initialised = closed.
   type :: h5_table_t
@@ -763,4 +763,16 @@ contains
     if (fid /= -1) call h5fclose_f(fid, h)
   end subroutine abandon
 
+
+  !> The linked HDF5 library's version, e.g. "1.10.8" (casca --version)
+  function hdf5_version() result(s)
+    character(len=:), allocatable :: s
+    integer :: major, minor, release, hdferr
+    call h5get_libversion_f(major, minor, release, hdferr)
+    if (hdferr /= 0) then
+      s = 'unknown'
+    else
+      s = itoa(major)//'.'//itoa(minor)//'.'//itoa(release)
+    end if
+  end function hdf5_version
 end module casca_hdf5_io

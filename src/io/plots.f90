@@ -1,10 +1,11 @@
 !> Time-history plots of a run, drawn by gnuplot from DIR/history.dat.
 !>
 !> make_plots reads only the header of history.dat (to learn the column numbers and the number
-!> K of tracked nodes), writes DIR/plots.gp and runs it with gnuplot inside DIR. The script names
-!> files relative to DIR and keeps the column numbers in variables at its top, so a user can
-!> edit it and re-run `gnuplot plots.gp` in the run folder without casca. Columns are looked up
-!> by name (not position), so extra columns added to history.dat later do not break the plots.
+!> K of tracked nodes), writes DIR/plots.gp and runs it with gnuplot inside DIR (gnuplot's
+!> messages go to DIR/gnuplot.log). The script names files relative to DIR and keeps the column
+!> numbers in variables at its top, so a user can edit it and re-run `gnuplot plots.gp` in the
+!> run folder without casca. Columns are looked up by name (not position), so extra columns
+!> added to history.dat later do not break the plots.
 !>
 !> Units are SI as the solver writes them (s, m, J, N); time is plotted in ms.
 module casca_plots
@@ -63,10 +64,12 @@ contains
 
     ! The one shell of casca: `command -v` is the portable way to ask whether gnuplot is on
     ! PATH (dash answers 127 for "not found", which gfortran reports as a cmdstat failure,
-    ! hence exit 99); the folder is one quoted word.
+    ! hence exit 99); the folder is one quoted word. gnuplot's messages go to gnuplot.log in
+    ! the folder, not the terminal: its warnings (an empty y range where a curve is flat, as
+    ! the energies of a static run) are not casca's, and a failure names the log.
     if (d(1:1) /= '/') d = './'//d   ! a folder named -x is not an option of cd
     cmd = 'cd '//shell_quote(d)//' && { command -v gnuplot >/dev/null 2>&1 || exit 99; } && ' &
-          //'gnuplot plots.gp'
+          //'gnuplot plots.gp 2>gnuplot.log'
     cmsg = ''
     call execute_command_line(cmd, exitstat=stat, cmdstat=cstat, cmdmsg=cmsg)
     if (cstat /= 0) then
@@ -74,7 +77,8 @@ contains
     else if (stat == 99) then
       if (present(gnuplot_missing)) gnuplot_missing = .true.
     else if (stat /= 0) then
-      call fatal_error(err, 'make_plots: `'//cmd//'` failed with exit status '//itoa(stat))
+      call fatal_error(err, 'make_plots: `'//cmd//'` failed with exit status '//itoa(stat)// &
+                       '; gnuplot''s messages are in '//d//'/gnuplot.log')
     end if
   end subroutine make_plots
 

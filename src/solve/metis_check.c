@@ -3,3 +3,12 @@
 #include <metis.h>
 
 _Static_assert(IDXTYPEWIDTH == 32, "casca needs METIS built with a 32-bit idx_t (IDXTYPEWIDTH 32)");
+
+/* The METIS version casca was built against (casca --version): metis.h's own numbers, as the
+ * library has no call that tells them. */
+void casca_metis_version(int *major, int *minor, int *subminor)
+{
+  *major = METIS_VER_MAJOR;
+  *minor = METIS_VER_MINOR;
+  *subminor = METIS_VER_SUBMINOR;
+}

@@ -6,10 +6,10 @@
 module casca_mumps_solver
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_mpi, only: group_handle
+  use casca_mpi, only: group_handle, comm_handle
   implicit none
   private
-  public :: sparse_solver_t
+  public :: sparse_solver_t, mumps_version
 
   include 'dmumps_struc.h'
 
@@ -42,6 +42,23 @@ module casca_mumps_solver
   end type sparse_solver_t
 
 contains
+
+  !> The linked MUMPS library's version, e.g. "5.5.1" (casca --version): MUMPS tells it only
+  !> through an instance, so one is started (JOB = -1) and ended (JOB = -2). Collective over
+  !> all ranks, like every MUMPS start.
+  function mumps_version() result(s)
+    character(len=:), allocatable :: s
+    type(dmumps_struc) :: id
+    id%comm = comm_handle()
+    id%sym = 0; id%par = 1
+    id%job = -1
+    call dmumps(id)
+    s = trim(adjustl(id%version_number))
+    if (id%info(1) < 0 .or. s == '') s = 'unknown'
+    id%icntl(1:3) = -1; id%icntl(4) = 0   ! JOB = -2 would print its banner
+    id%job = -2
+    call dmumps(id)
+  end function mumps_version
 
   !> Start MUMPS on this rank's group of ngroups (collective over all ranks when it changes).
   subroutine solver_init(self, ngroups)
