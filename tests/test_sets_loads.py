@@ -12,6 +12,13 @@ sets      examples/cantilever.nml on the file mesh, clamped by set = 'clamped' a
           x = 10): the tracked tip displacement (x, z) at P = 4 is the same to 1e-12 relative,
           for the MSH 4.1 and the MSH 2.2 file (the set and the box select the same nodes, so
           the two runs are the same computation).
+gmsh      the same for a file Gmsh itself wrote: tests/data/gmsh_tri10_v22.msh (a closed
+          cylinder's wall, radius 1, z in [-0.5, 0.5], saved through its physical groups
+          'wall' and 'rims', the rims as 4-node lines) clamped by set = 'rims' vs by two boxes
+          z <= -0.5 + 1e-9 and z >= 0.5 - 1e-9, statics under a radial point load at mid-height:
+          the loaded point's displacement is the same to 1e-12 relative (the file's rims are
+          2 x 11 cubic lines, 66 nodes, all at z = +-0.5: a node missed or added by the set
+          would change the answer).
 missing   set = 'tp' in &load: exit 2, and the message names the deck file and the line of
           the &load group, the group, the set and the body's groups:
           "FILE:LINE: &load: set 'tp' is not a physical group of body 'strip' (its groups:
@@ -78,6 +85,23 @@ for ver in ("v41", "v22"):
     if hb is not None and hs is not None:
         ck.close("sets %s: tip z by set vs by box" % ver, hs["p1_z"][-1], hb["p1_z"][-1], 1e-12)
         ck.close("sets %s: tip x by set vs by box" % ver, hs["p1_x"][-1], hb["p1_x"][-1], 1e-12)
+
+# gmsh
+CYL = """&run analysis = 'static', load_steps = 2 /
+&output vtu = .false., plots = .false., track = 1.0, 0.0, 0.0 /
+&body name = 'cyl', mesh = 'file', file = '%s'
+  young = 1e6, poisson = 0.3, density = 1.0, thickness = 0.02 /
+%s
+&load body = 'cyl', box_min = 0.999, -0.05, -0.05, box_max = 1.001, 0.05, 0.05, force = -0.01, 0.0, 0.0 /
+""" % (os.path.join(data, "gmsh_tri10_v22.msh"), "%s")
+hs, ps, _ = run_deck("gmsh_set", CYL % "&restraint body = 'cyl', set = 'rims' /")
+hb, pb, _ = run_deck("gmsh_box", CYL % ("&restraint body = 'cyl', box_max = 9, 9, -0.499999999 /\n"
+                                        "&restraint body = 'cyl', box_min = -9, -9, 0.499999999 /"))
+ck.record("gmsh: set deck runs (exit 0)", ps.returncode == 0, ps.stderr[-300:])
+ck.record("gmsh: box deck runs (exit 0)", pb.returncode == 0, pb.stderr[-300:])
+if hs is not None and hb is not None:
+    ck.close("gmsh: loaded point x by set 'rims' vs by boxes", hs["p1_x"][-1], hb["p1_x"][-1], 1e-12)
+    ck.record("gmsh: the load moves the point (x < 1)", hs["p1_x"][-1] < 1.0, "%.10g" % hs["p1_x"][-1])
 
 # missing
 text = cantilever("strip_sets_v41.msh", "set = 'clamped'", "set = 'tp'")

@@ -694,37 +694,52 @@ contains
     type(mesh_t), intent(inout) :: mesh
     type(error_t), allocatable, intent(out) :: err
     character(len=256), allocatable :: names(:)
-    character(len=256) :: nm
     character(len=24) :: tagstr
-    logical, allocatable :: in_set(:)
+    logical, allocatable :: in_set(:), same(:)
+    integer, allocatable :: gdim(:), gtag(:), gidx(:)
     type(node_set_t), allocatable :: grown(:)
-    integer :: m, j, k, pos
+    integer :: m, j, g, ng, pos
 
-    allocate (names(raw%nmember), mesh%sets(0))
+    ! the distinct groups (dimension, tag): few, while a surface group has 10 entries a triangle
+    allocate (gdim(0), gtag(0), gidx(raw%nmember), mesh%sets(0))
+    ng = 0
     do m = 1, raw%nmember
-      names(m) = group_name(int(raw%member(1, m)), int(raw%member(2, m)))
+      g = 0
+      do j = 1, ng
+        if (gdim(j) == raw%member(1, m) .and. gtag(j) == raw%member(2, m)) then
+          g = j; exit
+        end if
+      end do
+      if (g == 0) then
+        gdim = [gdim, int(raw%member(1, m))]; gtag = [gtag, int(raw%member(2, m))]
+        ng = ng + 1; g = ng
+      end if
+      gidx(m) = g
     end do
-    allocate (in_set(mesh%nnode))
-    do m = 1, raw%nmember
-      if (any(names(1:m - 1) == names(m))) cycle   ! (a group already built)
-      nm = names(m)
+    allocate (names(ng), in_set(mesh%nnode))
+    do g = 1, ng
+      names(g) = group_name(gdim(g), gtag(g))
+    end do
+    do g = 1, ng
+      if (any(names(1:g - 1) == names(g))) cycle   ! (its name's set is built)
+      same = names == names(g)
       in_set = .false.
-      do k = m, raw%nmember
-        if (names(k) /= nm) cycle
-        pos = find_sorted(sorted_tag, raw%member(3, k))
+      do m = 1, raw%nmember
+        if (.not. same(gidx(m))) cycle
+        pos = find_sorted(sorted_tag, raw%member(3, m))
         if (pos > 0) then
           if (new_id(pos) > 0) then
             in_set(new_id(pos)) = .true.
             cycle
           end if
         end if
-        write (tagstr, '(i0)') raw%member(3, k)
-        cur%line = int(raw%member(4, k))
+        write (tagstr, '(i0)') raw%member(3, m)
+        cur%line = int(raw%member(4, m))
         if (pos == 0) then
-          call fail(err, cur, "physical group '" // trim(nm) // "': element refers to node tag " // &
+          call fail(err, cur, "physical group '" // trim(names(g)) // "': element refers to node tag " // &
                     trim(tagstr) // ", which is not defined in $Nodes")
         else
-          call fail(err, cur, "physical group '" // trim(nm) // "': node tag " // trim(tagstr) // &
+          call fail(err, cur, "physical group '" // trim(names(g)) // "': node tag " // trim(tagstr) // &
                     " is on no 10-node triangle")
         end if
         return
@@ -735,7 +750,7 @@ contains
         call move_alloc(mesh%sets(j)%name, grown(j)%name)
         call move_alloc(mesh%sets(j)%nodes, grown(j)%nodes)
       end do
-      grown(size(grown))%name = trim(nm)
+      grown(size(grown))%name = trim(names(g))
       grown(size(grown))%nodes = pack([(j, j=1, mesh%nnode)], in_set)
       call move_alloc(grown, mesh%sets)
     end do
