@@ -29,6 +29,14 @@ edge      cantilever.nml with kind = 'edge' on the tip: Sze, Liu & Lo (2004), Fi
           MBDyn's tests/plates/sze2004/sze31/sze31_ref.dat); bound 1% (Sze's 16 x 1 S4R
           solution; the elastica is within 0.1% of it). The difference from the equal shares
           (kind = 'nodal', the shipped deck) is printed, not asserted.
+patch     the membrane patch test of the edge load: the strip (nu = 0) clamped at x = 0 and
+          pulled along x by F = 1.2 N as kind = 'edge' on set 'tip' (sigma = F/(b h) = 12 Pa,
+          sigma/E = 1e-5), one load step, newton_tol 1e-14. A uniform traction gives a uniform
+          uniaxial state, which the cubic elements hold exactly; the material is Saint-Venant-
+          Kirchhoff (nu = 0: lambda = 0, no lateral or thickness strain), so the stretch
+          l = 1 + e solves E e (1 + e/2)(1 + e) = sigma (first Piola stress of a dead load):
+          e = 0.99998500040e-5. Each of the 4 tip nodes must move by e L, to 1e-8 relative
+          (the equal shares of kind = 'nodal' miss this by 4.5% at the corners: printed).
 sum       the nodal forces of an edge load add up to the given force: a free strip (no
           restraint, no gravity, trapezoidal Newmark beta 1/4, gamma 1/2) under an edge load
           F = (0, 0, 0.5) N on set 'tip': from step 1 to step N its linear momentum changes by
@@ -130,6 +138,37 @@ if he is not None:
         print("INFO edge vs Sze: W off by %.3g%%, -U off by %.3g%%; nodal vs Sze: W off by %.3g%%, "
               "-U off by %.3g%%" % (100 * (he["p1_z"][-1] / SZE_W - 1), 100 * ((10 - he["p1_x"][-1]) / SZE_U - 1),
                                    100 * (hn["p1_z"][-1] / SZE_W - 1), 100 * ((10 - hn["p1_x"][-1]) / SZE_U - 1)))
+
+# patch
+def stretch(sig_over_e):
+    """e with e (1 + e/2)(1 + e) = sigma/E (Newton from e = sigma/E)."""
+    e = sig_over_e
+    for _ in range(50):
+        e -= (e * (1 + e) * (1 + e / 2) - sig_over_e) / ((1 + e) * (1 + e / 2) + e * (1 + e / 2) + e * (1 + e) / 2)
+    return e
+
+
+PATCH = """&run analysis = 'static', load_steps = 1, newton_tol = 1e-14 /
+&output vtu = .false., plots = .false.,
+  track = 10,0,0, 10,0.3333333333333333,0, 10,0.6666666666666666,0, 10,1,0 /
+&body name = 'strip', mesh = 'file', file = '%s'
+  young = 1.2e6, poisson = 0.0, density = 1.0, thickness = 0.1 /
+&restraint body = 'strip', set = 'clamped', fix = 'clamped' /
+&load body = 'strip', set = 'tip', kind = '%s', force = 1.2, 0.0, 0.0 /
+""" % (os.path.join(data, "strip_sets_v41.msh"), "%s")
+u_exact = 10.0 * stretch(1.2 / (1.0 * 0.1) / 1.2e6)
+for kind in ("edge", "nodal"):
+    hp, pp, _ = run_deck("patch_" + kind, PATCH % kind)
+    ck.record("patch %s: runs (exit 0)" % kind, pp.returncode == 0, pp.stderr[-300:])
+    if hp is None:
+        continue
+    for i, y in enumerate(("0", "1/3", "2/3", "1")):
+        u = hp["p%d_x" % (i + 1)][-1] - 10.0
+        if kind == "edge":
+            ck.close("patch edge: tip node y = %s stretch vs SVK uniaxial e L" % y, u, u_exact, 1e-8)
+        else:
+            print("INFO patch nodal (equal shares): tip node y = %s moves %.10g, %.3g%% from e L"
+                  % (y, u, 100 * (u / u_exact - 1)))
 
 # sum
 FZ = 0.5
