@@ -2,8 +2,10 @@
 !>   &run        analysis, time step, end time, Newmark and Newton parameters, gravity
 !>   &output     folder, frame interval, tracked points, checkpoint interval
 !>   &body       (one per body) mesh or generator, material, thickness, initial motion
-!>   &restraint  (any number) prescribed parameters of a body's nodes: a box or a node set
-!>   &load       (any number) a dead force shared by a body's nodes: a box or a node set
+!>   &restraint  (any number) prescribed parameters of a body's nodes: a box, a node list or
+!>               a named set (a physical group of the body's mesh file)
+!>   &load       (any number) a dead force on a body's nodes (box, list or set): shared equally
+!>               ('nodal') or a uniform line load on the selected boundary edge ('edge')
 !>   &contact    contact pairs, surfaces and tolerances
 !>   &obstacle   (any number) a rigid plane, sphere or cylinder, fixed or moving
 !> Every problem found while reading is collected (file:line: group: message) so that the
@@ -75,7 +77,8 @@ module casca_deck
   type :: restraint_cfg_t
     character(len=64) :: body = ''
     real(dp) :: box_min(3) = -huge(1._dp), box_max(3) = huge(1._dp)
-    integer, allocatable :: nodes(:)            !< node numbers in the body (a node set)
+    integer, allocatable :: nodes(:)            !< node numbers in the body (a node list)
+    character(len=64) :: set = ''               !< a physical group of the body's mesh file
     character(len=64) :: fix = 'clamped'
     integer :: line = 0
   end type restraint_cfg_t
@@ -83,8 +86,10 @@ module casca_deck
   type :: load_cfg_t
     character(len=64) :: body = ''
     real(dp) :: box_min(3) = -huge(1._dp), box_max(3) = huge(1._dp)
-    integer, allocatable :: nodes(:)            !< node numbers in the body (a node set)
-    real(dp) :: force(3) = 0                    !< total, shared equally by the nodes
+    integer, allocatable :: nodes(:)            !< node numbers in the body (a node list)
+    character(len=64) :: set = ''               !< a physical group of the body's mesh file
+    character(len=16) :: kind = 'nodal'         !< 'nodal': shared equally; 'edge': line load
+    real(dp) :: force(3) = 0                    !< total
     integer :: line = 0
   end type load_cfg_t
 
@@ -282,16 +287,17 @@ contains
     subroutine read_restraints(uu, dk)
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
-      character(len=long) :: body, fix
+      character(len=long) :: body, fix, set
       real(dp) :: box_min(3), box_max(3)
       integer :: nodes(max_set)
-      namelist /restraint/ body, box_min, box_max, fix, nodes
+      namelist /restraint/ body, box_min, box_max, fix, nodes, set
       type(restraint_cfg_t) :: r
       integer :: ir
       rewind (uu)
       do ir = 1, count(gname == 'restraint')
         r = restraint_cfg_t()
         body = r%body; fix = r%fix; box_min = r%box_min; box_max = r%box_max; nodes = 0
+        set = r%set
         read (uu, nml=restraint, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('restraint', ir), '&restraint: '//trim(msg))
@@ -300,6 +306,7 @@ contains
         r%line = line_of('restraint', ir)
         call take(dk, r%line, '&restraint: body', body, r%body)
         call take(dk, r%line, '&restraint: fix', fix, r%fix)
+        call take(dk, r%line, '&restraint: set', set, r%set)
         r%box_min = box_min; r%box_max = box_max
         r%nodes = pack(nodes, nodes /= 0)
         dk%restraints = [dk%restraints, r]
@@ -309,16 +316,17 @@ contains
     subroutine read_loads(uu, dk)
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
-      character(len=long) :: body
+      character(len=long) :: body, set, kind
       real(dp) :: box_min(3), box_max(3), force(3)
       integer :: nodes(max_set)
-      namelist /load/ body, box_min, box_max, force, nodes
+      namelist /load/ body, box_min, box_max, force, nodes, set, kind
       type(load_cfg_t) :: l
       integer :: il
       rewind (uu)
       do il = 1, count(gname == 'load')
         l = load_cfg_t()
         body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force; nodes = 0
+        set = l%set; kind = l%kind
         read (uu, nml=load, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('load', il), '&load: '//trim(msg))
@@ -326,6 +334,8 @@ contains
         end if
         l%line = line_of('load', il)
         call take(dk, l%line, '&load: body', body, l%body)
+        call take(dk, l%line, '&load: set', set, l%set)
+        call take(dk, l%line, '&load: kind', lower(kind), l%kind)
         l%box_min = box_min; l%box_max = box_max; l%force = force
         l%nodes = pack(nodes, nodes /= 0)
         dk%loads = [dk%loads, l]

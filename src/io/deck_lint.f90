@@ -36,13 +36,13 @@ contains
       end select
     case ('restraint')
       select case (key)
-      case ('body', 'fix'); t = 's'
+      case ('body', 'fix', 'set'); t = 's'
       case ('box_min', 'box_max'); t = 'r'
       case ('nodes'); t = 'i'
       end select
     case ('load')
       select case (key)
-      case ('body'); t = 's'
+      case ('body', 'set', 'kind'); t = 's'
       case ('box_min', 'box_max', 'force'); t = 'r'
       case ('nodes'); t = 'i'
       end select
@@ -234,7 +234,7 @@ contains
       'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
       'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
       'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &
-      'force', 'pairs', 'tolerance', 'enabled', 'solver', 'normal', 'nodes']
+      'force', 'pairs', 'tolerance', 'enabled', 'solver', 'normal', 'nodes', 'set', 'kind']
     integer :: i, d, best
     s = ''
     best = 3

@@ -1,12 +1,14 @@
 !> Gmsh MSH files (ASCII 4.1 and 2.2) holding 10-node cubic triangles (Gmsh element type 21).
 !>
 !> Gmsh's TRI10 node order is casca's order (see casca_mesh), so connectivity is copied as is.
+!> Physical groups of points (type 15), lines (1, 8, 26) and triangles (2, 21) become the
+!> mesh's named node sets (mesh%sets): every node of their elements, in the mesh's numbering.
 !> The reader loads the whole file into memory and walks it line by line, so that every error
 !> names the file and the line where it was found; it never stops the program.
 module casca_gmsh_io
   use casca_kinds, only: dp, i8
   use casca_error, only: error_t, fatal_error
-  use casca_mesh, only: mesh_t, nen
+  use casca_mesh, only: mesh_t, nen, node_set_t
   use casca_files, only: file_kind, kind_folder, kind_special, kind_regular, close_complete, &
                          delete_file, rename_file
   use, intrinsic :: iso_fortran_env, only: int64
@@ -36,6 +38,16 @@ module casca_gmsh_io
     integer :: nelem = 0
     integer(i8), allocatable :: elem_nodes(:, :)
     integer, allocatable :: elem_line(:)
+    !> $PhysicalNames: dimension, tag, name
+    integer :: nnames = 0
+    integer, allocatable :: name_dim(:), name_tag(:)
+    character(len=256), allocatable :: name_text(:)
+    !> MSH 4.1 $Entities: (dimension, entity tag, physical tag) for each physical tag of an entity
+    integer :: nent = 0
+    integer, allocatable :: ent(:, :)
+    !> nodes of physical groups: (dimension, physical tag, node tag, line of the element)
+    integer :: nmember = 0
+    integer(i8), allocatable :: member(:, :)
   end type raw_t
 
 contains
@@ -100,8 +112,16 @@ contains
           call read_elements_v22(cur, raw, err)
         end if
         have_elements = .true.
+      case ('PhysicalNames')
+        call read_physical_names(cur, raw, err)
+      case ('Entities')
+        if (version == 41) then
+          call read_entities_v41(cur, raw, err)
+        else
+          call skip_section(cur, section, section_line, err)
+        end if
       case default
-        ! $PhysicalNames, $Entities, $PartitionedEntities, $NodeData, ...: not needed here.
+        ! $PartitionedEntities, $NodeData, ...: not needed here.
         call skip_section(cur, section, section_line, err)
       end select
       if (allocated(err)) return
@@ -345,8 +365,10 @@ contains
     type(cursor_t), intent(inout) :: cur
     type(raw_t), intent(inout) :: raw
     type(error_t), allocatable, intent(out) :: err
-    integer(i8) :: nblocks, nelems, min_tag, max_tag, tag
-    integer :: s, e, ios, ib, k, dim, etag, etype, nin
+    integer(i8) :: nblocks, nelems, min_tag, max_tag, tag, enodes(nen)
+    integer :: s, e, ios, ib, k, dim, etag, etype, nin, nn, i
+    integer, allocatable :: phys(:)
+    character(len=16) :: what
 
     if (.not. need_line(cur, s, e, "$Elements", err)) return
     read (cur%buf(s:e), *, iostat=ios) nblocks, nelems, min_tag, max_tag
@@ -369,21 +391,43 @@ contains
                   // "(entityDim entityTag elementType numElementsInBlock), found '" // clip(cur%buf(s:e)) // "'")
         return
       end if
+      if (raw%nent > 0) then
+        phys = pack(raw%ent(3, 1:raw%nent), raw%ent(1, 1:raw%nent) == dim .and. &
+                    raw%ent(2, 1:raw%nent) == etag)
+      else
+        phys = [integer ::]   ! (no $Entities section)
+      end if
+      nn = nodes_of_type(etype)
       do k = 1, nin
         if (.not. need_line(cur, s, e, "$Elements", err)) return
-        if (etype /= tri10_type) cycle     ! points, lines, other surfaces: not casca's
-        if (raw%nelem >= size(raw%elem_line)) then
-          call fail(err, cur, "more elements than announced in the $Elements header")
-          return
+        if (etype == tri10_type) then
+          if (raw%nelem >= size(raw%elem_line)) then
+            call fail(err, cur, "more elements than announced in the $Elements header")
+            return
+          end if
+          read (cur%buf(s:e), *, iostat=ios) tag, raw%elem_nodes(:, raw%nelem + 1)
+          if (ios /= 0) then
+            call fail(err, cur, "expected 11 integers 'element-tag node1 ... node10' for a type-21 triangle, found '" &
+                      // clip(cur%buf(s:e)) // "'")
+            return
+          end if
+          raw%nelem = raw%nelem + 1
+          raw%elem_line(raw%nelem) = cur%line
+          enodes(1:nn) = raw%elem_nodes(:, raw%nelem)
+        else if (nn > 0 .and. size(phys) > 0) then
+          read (cur%buf(s:e), *, iostat=ios) tag, enodes(1:nn)
+          if (ios /= 0) then
+            write (what, '(i0)') nn + 1
+            call fail(err, cur, "expected " // trim(what) // " integers 'element-tag node...' for an element of a " &
+                      // "physical group, found '" // clip(cur%buf(s:e)) // "'")
+            return
+          end if
+        else
+          cycle     ! other element types, elements of no physical group: not casca's
         end if
-        read (cur%buf(s:e), *, iostat=ios) tag, raw%elem_nodes(:, raw%nelem + 1)
-        if (ios /= 0) then
-          call fail(err, cur, "expected 11 integers 'element-tag node1 ... node10' for a type-21 triangle, found '" &
-                    // clip(cur%buf(s:e)) // "'")
-          return
-        end if
-        raw%nelem = raw%nelem + 1
-        raw%elem_line(raw%nelem) = cur%line
+        do i = 1, size(phys)
+          call add_members(raw, dim, phys(i), enodes(1:nn), cur%line)
+        end do
       end do
     end do
     call expect_end(cur, 'Elements', err)
@@ -394,8 +438,10 @@ contains
     type(cursor_t), intent(inout) :: cur
     type(raw_t), intent(inout) :: raw
     type(error_t), allocatable, intent(out) :: err
-    integer :: s, e, ios, k, n, i, tag, etype, ntags
+    integer :: s, e, ios, k, n, i, tag, etype, ntags, nn
     integer :: tags(64)
+    integer(i8) :: enodes(nen)
+    character(len=16) :: what
 
     if (.not. need_line(cur, s, e, "$Elements", err)) return
     read (cur%buf(s:e), *, iostat=ios) n
@@ -412,22 +458,151 @@ contains
         call fail(err, cur, "expected 'element-tag type number-of-tags ...', found '" // clip(cur%buf(s:e)) // "'")
         return
       end if
-      if (etype /= tri10_type) cycle
+      nn = nodes_of_type(etype)
+      if (nn == 0) cycle                   ! volumes, quadrangles, ...: not casca's
       if (ntags < 0 .or. ntags > size(tags)) then
         call fail(err, cur, "invalid number of element tags")
         return
       end if
-      read (cur%buf(s:e), *, iostat=ios) tag, etype, ntags, (tags(i), i=1, ntags), raw%elem_nodes(:, raw%nelem + 1)
-      if (ios /= 0) then
-        call fail(err, cur, "expected 10 node tags after the element tags of a type-21 triangle, found '" &
-                  // clip(cur%buf(s:e)) // "'")
-        return
+      if (etype == tri10_type) then
+        read (cur%buf(s:e), *, iostat=ios) tag, etype, ntags, (tags(i), i=1, ntags), raw%elem_nodes(:, raw%nelem + 1)
+        if (ios /= 0) then
+          call fail(err, cur, "expected 10 node tags after the element tags of a type-21 triangle, found '" &
+                    // clip(cur%buf(s:e)) // "'")
+          return
+        end if
+        raw%nelem = raw%nelem + 1
+        raw%elem_line(raw%nelem) = cur%line
+        enodes = raw%elem_nodes(:, raw%nelem)
+      else
+        if (ntags < 1) cycle               ! (the first tag is the physical group)
+        read (cur%buf(s:e), *, iostat=ios) tag, etype, ntags, (tags(i), i=1, ntags), enodes(1:nn)
+        if (ios /= 0) then
+          write (what, '(i0)') nn
+          call fail(err, cur, "expected " // trim(what) // " node tags after the element tags, found '" &
+                    // clip(cur%buf(s:e)) // "'")
+          return
+        end if
       end if
-      raw%nelem = raw%nelem + 1
-      raw%elem_line(raw%nelem) = cur%line
+      if (ntags >= 1) then
+        if (tags(1) /= 0) call add_members(raw, dim_of_type(etype), tags(1), enodes(1:nn), cur%line)
+      end if
     end do
     call expect_end(cur, 'Elements', err)
   end subroutine read_elements_v22
+
+  !> "$PhysicalNames": the number of names, then 'dimension tag "name"' lines.
+  subroutine read_physical_names(cur, raw, err)
+    type(cursor_t), intent(inout) :: cur
+    type(raw_t), intent(inout) :: raw
+    type(error_t), allocatable, intent(out) :: err
+    integer :: s, e, ios, k, n, q1, q2
+    if (.not. need_line(cur, s, e, "$PhysicalNames", err)) return
+    read (cur%buf(s:e), *, iostat=ios) n
+    if (ios /= 0 .or. n < 0) then
+      call fail(err, cur, "expected the number of names in $PhysicalNames, found '" // clip(cur%buf(s:e)) // "'")
+      return
+    end if
+    allocate (raw%name_dim(n), raw%name_tag(n), raw%name_text(n))
+    do k = 1, n
+      ! (not need_line: a name may hold a ',' or '/')
+      if (.not. next_line(cur, s, e)) then
+        cur%line = cur%line + 1
+        call fail(err, cur, "unexpected end of file inside $PhysicalNames (file truncated?)")
+        return
+      end if
+      q1 = index(cur%buf(s:e), '"')
+      q2 = index(cur%buf(s:e), '"', back=.true.)
+      ios = 1
+      if (q2 > q1 + 1) read (cur%buf(s:s + q1 - 2), *, iostat=ios) raw%name_dim(k), raw%name_tag(k)
+      if (ios /= 0) then
+        call fail(err, cur, "expected 'dimension tag ""name""' in $PhysicalNames, found '" // clip(cur%buf(s:e)) // "'")
+        return
+      end if
+      raw%name_text(k) = cur%buf(s + q1:s + q2 - 2)
+    end do
+    raw%nnames = n
+    call expect_end(cur, 'PhysicalNames', err)
+  end subroutine read_physical_names
+
+  !> MSH 4.1 "$Entities": "numPoints numCurves numSurfaces numVolumes", then one line per
+  !> entity: points "tag x y z numPhysicalTags physicalTag...", the others "tag minX minY minZ
+  !> maxX maxY maxZ numPhysicalTags physicalTag... numBounding boundingTag...". Only the
+  !> physical tags are kept.
+  subroutine read_entities_v41(cur, raw, err)
+    type(cursor_t), intent(inout) :: cur
+    type(raw_t), intent(inout) :: raw
+    type(error_t), allocatable, intent(out) :: err
+    integer :: s, e, ios, counts(4), dim, k, tag, np, nbox, i
+    real(dp) :: box(6)
+    integer :: phys(256)
+    if (.not. need_line(cur, s, e, "$Entities", err)) return
+    read (cur%buf(s:e), *, iostat=ios) counts
+    if (ios /= 0 .or. any(counts < 0)) then
+      call fail(err, cur, "expected 4 counts in $Entities, found '" // clip(cur%buf(s:e)) // "'")
+      return
+    end if
+    allocate (raw%ent(3, 16))
+    do dim = 0, 3
+      nbox = merge(3, 6, dim == 0)
+      do k = 1, counts(dim + 1)
+        if (.not. need_line(cur, s, e, "$Entities", err)) return
+        read (cur%buf(s:e), *, iostat=ios) tag, box(1:nbox), np
+        if (ios == 0 .and. (np < 0 .or. np > size(phys))) ios = 1
+        if (ios == 0) read (cur%buf(s:e), *, iostat=ios) tag, box(1:nbox), np, phys(1:np)
+        if (ios /= 0) then
+          call fail(err, cur, "expected an entity 'tag bounds... numPhysicalTags physicalTag...', found '" &
+                    // clip(cur%buf(s:e)) // "'")
+          return
+        end if
+        do i = 1, np
+          if (raw%nent == size(raw%ent, 2)) raw%ent = reshape(raw%ent, [3, 2*raw%nent], pad=[0])
+          raw%nent = raw%nent + 1
+          raw%ent(:, raw%nent) = [dim, tag, abs(phys(i))]   ! (a sign is an orientation)
+        end do
+      end do
+    end do
+    call expect_end(cur, 'Entities', err)
+  end subroutine read_entities_v41
+
+  !> Record the nodes of an element of physical group (dim, phys), found at line.
+  subroutine add_members(raw, dim, phys, nodes, line)
+    type(raw_t), intent(inout) :: raw
+    integer, intent(in) :: dim, phys, line
+    integer(i8), intent(in) :: nodes(:)
+    integer :: k
+    if (.not. allocated(raw%member)) allocate (raw%member(4, 64))
+    do k = 1, size(nodes)
+      if (raw%nmember == size(raw%member, 2)) &
+        raw%member = reshape(raw%member, [4, 2*raw%nmember], pad=[0_i8])
+      raw%nmember = raw%nmember + 1
+      raw%member(:, raw%nmember) = [int(dim, i8), int(phys, i8), nodes(k), int(line, i8)]
+    end do
+  end subroutine add_members
+
+  !> Nodes of the element types a physical group may hold: point, 2-, 3- and 4-node lines,
+  !> 3- and 10-node triangles; 0 for the others.
+  pure integer function nodes_of_type(etype)
+    integer, intent(in) :: etype
+    select case (etype)
+    case (15); nodes_of_type = 1
+    case (1); nodes_of_type = 2
+    case (8); nodes_of_type = 3
+    case (26); nodes_of_type = 4
+    case (2); nodes_of_type = 3
+    case (tri10_type); nodes_of_type = nen
+    case default; nodes_of_type = 0
+    end select
+  end function nodes_of_type
+
+  pure integer function dim_of_type(etype)
+    integer, intent(in) :: etype
+    select case (etype)
+    case (15); dim_of_type = 0
+    case (1, 8, 26); dim_of_type = 1
+    case default; dim_of_type = 2
+    end select
+  end function dim_of_type
 
   !> Skip an unneeded section up to its "$End" line.
   subroutine skip_section(cur, section, start_line, err)
@@ -505,7 +680,93 @@ contains
     do ie = 1, raw%nelem
       mesh%conn(:, ie) = new_id(conn_sorted(:, ie))
     end do
+    call build_sets(cur, raw, sorted_tag, new_id, mesh, err)
   end subroutine build_mesh
+
+  !> The physical groups as node sets: named by $PhysicalNames (else by their tag), groups of
+  !> one name merged, nodes in the mesh's numbering. A node that no 10-node triangle uses is
+  !> an error: the group would select nothing casca knows.
+  subroutine build_sets(cur, raw, sorted_tag, new_id, mesh, err)
+    type(cursor_t), intent(inout) :: cur
+    type(raw_t), intent(in) :: raw
+    integer(i8), intent(in) :: sorted_tag(:)
+    integer, intent(in) :: new_id(:)
+    type(mesh_t), intent(inout) :: mesh
+    type(error_t), allocatable, intent(out) :: err
+    character(len=256), allocatable :: names(:)
+    character(len=24) :: tagstr
+    logical, allocatable :: in_set(:), same(:)
+    integer, allocatable :: gdim(:), gtag(:), gidx(:)
+    type(node_set_t), allocatable :: grown(:)
+    integer :: m, j, g, ng, pos
+
+    ! the distinct groups (dimension, tag): few, while a surface group has 10 entries a triangle
+    allocate (gdim(0), gtag(0), gidx(raw%nmember), mesh%sets(0))
+    ng = 0
+    do m = 1, raw%nmember
+      g = 0
+      do j = 1, ng
+        if (gdim(j) == raw%member(1, m) .and. gtag(j) == raw%member(2, m)) then
+          g = j; exit
+        end if
+      end do
+      if (g == 0) then
+        gdim = [gdim, int(raw%member(1, m))]; gtag = [gtag, int(raw%member(2, m))]
+        ng = ng + 1; g = ng
+      end if
+      gidx(m) = g
+    end do
+    allocate (names(ng), in_set(mesh%nnode))
+    do g = 1, ng
+      names(g) = group_name(gdim(g), gtag(g))
+    end do
+    do g = 1, ng
+      if (any(names(1:g - 1) == names(g))) cycle   ! (its name's set is built)
+      same = names == names(g)
+      in_set = .false.
+      do m = 1, raw%nmember
+        if (.not. same(gidx(m))) cycle
+        pos = find_sorted(sorted_tag, raw%member(3, m))
+        if (pos > 0) then
+          if (new_id(pos) > 0) then
+            in_set(new_id(pos)) = .true.
+            cycle
+          end if
+        end if
+        write (tagstr, '(i0)') raw%member(3, m)
+        cur%line = int(raw%member(4, m))
+        if (pos == 0) then
+          call fail(err, cur, "physical group '" // trim(names(g)) // "': element refers to node tag " // &
+                    trim(tagstr) // ", which is not defined in $Nodes")
+        else
+          call fail(err, cur, "physical group '" // trim(names(g)) // "': node tag " // trim(tagstr) // &
+                    " is on no 10-node triangle")
+        end if
+        return
+      end do
+      ! (grown by hand: gfortran garbles a deferred-length name in an array constructor)
+      allocate (grown(size(mesh%sets) + 1))
+      do j = 1, size(mesh%sets)
+        call move_alloc(mesh%sets(j)%name, grown(j)%name)
+        call move_alloc(mesh%sets(j)%nodes, grown(j)%nodes)
+      end do
+      grown(size(grown))%name = trim(names(g))
+      grown(size(grown))%nodes = pack([(j, j=1, mesh%nnode)], in_set)
+      call move_alloc(grown, mesh%sets)
+    end do
+  contains
+    function group_name(dim, tag) result(r)
+      integer, intent(in) :: dim, tag
+      character(len=256) :: r
+      integer :: i
+      do i = 1, raw%nnames
+        if (raw%name_dim(i) == dim .and. raw%name_tag(i) == tag) then
+          r = raw%name_text(i); return
+        end if
+      end do
+      write (r, '(i0)') tag
+    end function group_name
+  end subroutine build_sets
 
   ! ---------------------------------------------------------------------------------------------
   ! Helpers

@@ -147,6 +147,7 @@ contains
           '&restraint: body = '''//trim(r%body)//''' is not a body of the deck')
         if (size(r%nodes) > 0 .and. r%body == '') call add_problem(deck, r%line, &
           '&restraint: nodes needs body = ... (node numbers count within a body)')
+        call check_selection(r%line, '&restraint', r%body, r%set, size(r%nodes), r%box_min, r%box_max)
         call parse_fix(r%fix, comps, ok)
         if (.not. ok) call add_problem(deck, r%line, '&restraint: fix = '''//trim(r%fix)// &
           ''' (use clamped, pinned, all, or components among x y z gx gy gz a)')
@@ -162,6 +163,9 @@ contains
           '&load: body = '''//trim(l%body)//''' is not a body of the deck')
         if (size(l%nodes) > 0 .and. l%body == '') call add_problem(deck, l%line, &
           '&load: nodes needs body = ... (node numbers count within a body)')
+        call check_selection(l%line, '&load', l%body, l%set, size(l%nodes), l%box_min, l%box_max)
+        if (l%kind /= 'nodal' .and. l%kind /= 'edge') call add_problem(deck, l%line, &
+          '&load: kind = '''//trim(l%kind)//''' (use nodal or edge)')
         if (any(l%box_min > l%box_max)) call add_problem(deck, l%line, &
           '&load: box_min must not exceed box_max')
         if (any(ieee_is_nan([l%box_min, l%box_max]))) call add_problem(deck, l%line, &
@@ -235,6 +239,19 @@ contains
 
     !> coefficients of friction: >= 0, below 10, the static one (when given) not below the
     !> dynamic one
+    !> A set needs its body and is the whole selection (neither a node list nor a box with it).
+    subroutine check_selection(line, group, body, set, nlist, lo, hi)
+      integer, intent(in) :: line, nlist
+      character(len=*), intent(in) :: group, body, set
+      real(dp), intent(in) :: lo(3), hi(3)
+      if (set == '') return
+      if (body == '') call add_problem(deck, line, group//': set needs body = ... (a set is '// &
+                                       'a physical group of a body''s mesh file)')
+      if (nlist > 0) call add_problem(deck, line, group//': give set or nodes, not both')
+      if (any(lo /= -huge(1._dp)) .or. any(hi /= huge(1._dp))) call add_problem(deck, line, &
+        group//': give set or box_min/box_max, not both')
+    end subroutine check_selection
+
     subroutine check_friction(line, group, dyn, sta)
       integer, intent(in) :: line
       character(len=*), intent(in) :: group

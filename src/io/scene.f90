@@ -9,6 +9,7 @@ module casca_scene
   use casca_deck, only: deck_t, add_problem, deck_file, unset
   use casca_sanity, only: parse_fix
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
+  use casca_node_selection, only: body_sets_t, select_nodes, edge_shares
   use casca_newmark, only: state_t
   use casca_vectors, only: cross
   use casca_obstacle, only: obstacle_t
@@ -69,8 +70,10 @@ contains
     type(mesh_t) :: mesh
     type(error_t), allocatable :: err
     logical :: comps(7), ok
-    integer :: ib, i, n, c, nsel
+    integer :: ib, i, n, c
     integer, allocatable :: sel(:)
+    real(dp), allocatable :: share(:)
+    type(body_sets_t) :: sets(size(deck%bodies))
 
     do ib = 1, size(deck%bodies)
       call body_mesh(deck, ib, mesh, err)
@@ -84,6 +87,11 @@ contains
                          ': the mesh has no 10-node triangle')
         cycle
       end if
+      if (allocated(mesh%sets)) then
+        call move_alloc(mesh%sets, sets(ib)%sets)
+      else
+        allocate (sets(ib)%sets(0))   ! (generated meshes have no named sets)
+      end if
       associate (b => deck%bodies(ib))
         call model_add_body(model, trim(b%name), mesh, b%young, b%poisson, b%density, b%thickness)
       end associate
@@ -96,11 +104,10 @@ contains
 
     do i = 1, size(deck%restraints)
       associate (r => deck%restraints(i))
-        if (.not. node_set('&restraint', r%body, r%nodes, r%line, sel)) cycle
-        if (size(r%nodes) == 0) sel = select_nodes(r%body, r%box_min, r%box_max)
-        if (size(sel) == 0) then
-          call add_problem(deck, r%line, '&restraint: no node of '//body_label(r%body)// &
-                           ' lies inside box_min..box_max'); cycle
+        call select_nodes(model, sets, '&restraint', r%body, r%nodes, r%set, r%box_min, r%box_max, &
+                          sel, err)
+        if (allocated(err)) then
+          call add_problem(deck, r%line, err%message); cycle
         end if
         call parse_fix(r%fix, comps, ok)
         do c = 1, 7
@@ -110,71 +117,25 @@ contains
     end do
     do i = 1, size(deck%loads)
       associate (l => deck%loads(i))
-        if (.not. node_set('&load', l%body, l%nodes, l%line, sel)) cycle
-        if (size(l%nodes) == 0) sel = select_nodes(l%body, l%box_min, l%box_max)
-        nsel = size(sel)
-        if (nsel == 0) then
-          call add_problem(deck, l%line, '&load: no node of '//body_label(l%body)// &
-                           ' lies inside box_min..box_max'); cycle
+        call select_nodes(model, sets, '&load', l%body, l%nodes, l%set, l%box_min, l%box_max, &
+                          sel, err)
+        if (.not. allocated(err)) then
+          if (l%kind == 'edge') then
+            call edge_shares(model, '&load', sel, share, err)
+          else
+            share = [(1._dp/size(sel), n=1, size(sel))]
+          end if
         end if
-        do n = 1, nsel
+        if (allocated(err)) then
+          call add_problem(deck, l%line, err%message); cycle
+        end if
+        do n = 1, size(sel)
           model%fext(dof(sel(n), 1):dof(sel(n), 3)) = model%fext(dof(sel(n), 1):dof(sel(n), 3)) &
-                                                      + l%force/nsel
+                                                      + share(n)*l%force
         end do
       end associate
     end do
     model%gravity = deck%run%gravity
-  contains
-    !> the model's numbers of a node set given within a body; .false. (and a problem) when a
-    !> number is out of range
-    logical function node_set(group, body, nodes, line, s)
-      character(len=*), intent(in) :: group, body
-      integer, intent(in) :: nodes(:), line
-      integer, allocatable, intent(out) :: s(:)
-      integer :: kb, k, n
-      character(len=160) :: msg
-      node_set = .true.
-      allocate (s(0))
-      if (size(nodes) == 0) return
-      kb = findloc([(model%body(k)%name == body, k=1, model%nbody)], .true., dim=1)
-      n = model%body(kb)%node_last - model%body(kb)%node_first + 1
-      do k = 1, size(nodes)
-        if (nodes(k) < 1 .or. nodes(k) > n) then
-          write (msg, '(a,a,i0,a,i0,a,i0,a)') group, ': nodes(', k, ') = ', nodes(k), &
-            ' is out of range 1..', n, ' of body '''//trim(body)//''''
-          call add_problem(deck, line, trim(msg))
-          node_set = .false.
-        end if
-      end do
-      if (node_set) s = nodes + model%body(kb)%node_first - 1
-    end function node_set
-
-    function select_nodes(body, lo, hi) result(s)
-      character(len=*), intent(in) :: body
-      real(dp), intent(in) :: lo(3), hi(3)
-      integer, allocatable :: s(:)
-      logical, allocatable :: mask(:)
-      integer :: k, kb
-      allocate (mask(model%nnode))
-      do k = 1, model%nnode
-        mask(k) = all(model%x0(:, k) >= lo) .and. all(model%x0(:, k) <= hi)
-      end do
-      if (body /= '') then
-        kb = findloc([(model%body(k)%name == body, k=1, model%nbody)], .true., dim=1)
-        mask = mask .and. model%node_body == kb
-      end if
-      s = pack([(k, k=1, model%nnode)], mask)
-    end function select_nodes
-
-    function body_label(body) result(s)
-      character(len=*), intent(in) :: body
-      character(len=:), allocatable :: s
-      if (body == '') then
-        s = 'any body'
-      else
-        s = 'body '''//trim(body)//''''
-      end if
-    end function body_label
   end subroutine build_model
 
   !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),

@@ -8,9 +8,15 @@ module casca_mesh
   use casca_kinds, only: dp
   implicit none
   private
-  public :: mesh_t, nen
+  public :: mesh_t, nen, node_set_t
 
   integer, parameter :: nen = 10   !< nodes per element
+
+  !> A named node set (a Gmsh physical group): its nodes in the mesh's numbering, ascending.
+  type :: node_set_t
+    character(len=:), allocatable :: name
+    integer, allocatable :: nodes(:)
+  end type node_set_t
 
   type :: mesh_t
     integer :: nnode = 0
@@ -18,5 +24,6 @@ module casca_mesh
     real(dp), allocatable :: x(:, :)       !< (3, nnode) mid-surface coordinates
     real(dp), allocatable :: normal(:, :)  !< (3, nnode) exact unit outward normals, or size 0 if unknown
     integer, allocatable :: conn(:, :)     !< (nen, nelem) node numbers, 1-based
+    type(node_set_t), allocatable :: sets(:)   !< physical groups of a mesh file (else none)
   end type mesh_t
 end module casca_mesh
