@@ -393,7 +393,7 @@ contains
     if (use_contact .and. r%deck%run%analysis /= 'static') call mass_setup(r%model, r%ls%mass, r%err)
   end subroutine setup_contact
 
-  !> Gravity's acceleration at the start, g on every point of a free body clear of contact
+  !> Gravity's acceleration at the start, the body's g on every point of a free body clear of contact
   !> (restrained or resting bodies start at rest, a = 0: their supports hold them). With 0
   !> for a falling body the first step would change its momentum by (gamma - 1/2) m g dt
   !> too much (thesis Newmark: 3e-5 of a bouncing ring's momentum change). (Not M^-1 f for
@@ -404,14 +404,17 @@ contains
     logical :: falls(r%model%nbody)
     integer :: b, n
     associate (model => r%model, st => r%st)
-      if (all(model%gravity == 0)) return
-      falls = [(.not. any(model%fixed(dof(model%body(b)%node_first, 1):dof(model%body(b)%node_last, 7))), &
-                b=1, model%nbody)]
+      do b = 1, model%nbody
+        associate (bd => model%body(b))
+          falls(b) = any(bd%gravity /= 0) .and. &
+                     .not. any(model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7)))
+        end associate
+      end do
       if (allocated(r%contact)) call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls)
       do b = 1, model%nbody
         if (.not. falls(b)) cycle
         do n = model%body(b)%node_first, model%body(b)%node_last
-          st%qdd(dof(n, 1):dof(n, 3)) = model%gravity
+          st%qdd(dof(n, 1):dof(n, 3)) = model%body(b)%gravity
         end do
       end do
     end associate

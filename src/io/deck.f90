@@ -71,6 +71,7 @@ module casca_deck
     real(dp) :: center(3) = 0                   !< ... and then moved by this vector
     real(dp) :: young = unset, poisson = 0.3_dp, density = unset, thickness = unset
     real(dp) :: velocity(3) = 0, omega(3) = 0   !< omega about the body's centroid
+    real(dp) :: gravity(3) = 0                  !< the body's own, added to &run's
     integer :: line = 0
   end type body_cfg_t
 
@@ -253,10 +254,11 @@ contains
       character(len=long) :: name, mesh, file
       real(dp) :: radius, width, lx, ly, center(3), young, poisson, density, thickness
       real(dp) :: rotate_axis(3), rotate_angle
-      real(dp) :: velocity(3), omega(3)
+      real(dp) :: velocity(3), omega(3), gravity(3)
       integer :: n_around, n_across, n_div, nx, ny, ib
       namelist /body/ name, mesh, file, radius, width, lx, ly, n_around, n_across, n_div, &
-        nx, ny, center, rotate_axis, rotate_angle, young, poisson, density, thickness, velocity, omega
+        nx, ny, center, rotate_axis, rotate_angle, young, poisson, density, thickness, velocity, omega, &
+        gravity
       type(body_cfg_t) :: b
       rewind (uu)
       do ib = 1, count(gname == 'body')
@@ -265,7 +267,7 @@ contains
         lx = b%lx; ly = b%ly; n_around = b%n_around; n_across = b%n_across; n_div = b%n_div
         nx = b%nx; ny = b%ny; center = b%center; young = b%young; poisson = b%poisson
         density = b%density; thickness = b%thickness; velocity = b%velocity; omega = b%omega
-        rotate_axis = b%rotate_axis; rotate_angle = b%rotate_angle
+        rotate_axis = b%rotate_axis; rotate_angle = b%rotate_angle; gravity = b%gravity
         read (uu, nml=body, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('body', ib), '&body: '//trim(msg))
@@ -279,7 +281,7 @@ contains
         b%lx = lx; b%ly = ly; b%n_around = n_around; b%n_across = n_across; b%n_div = n_div
         b%nx = nx; b%ny = ny; b%center = center; b%young = young; b%poisson = poisson
         b%density = density; b%thickness = thickness; b%velocity = velocity; b%omega = omega
-        b%rotate_axis = rotate_axis; b%rotate_angle = rotate_angle
+        b%rotate_axis = rotate_axis; b%rotate_angle = rotate_angle; b%gravity = gravity
         dk%bodies = [dk%bodies, b]
       end do
     end subroutine read_bodies

@@ -31,7 +31,7 @@ contains
       select case (key)
       case ('name', 'mesh', 'file'); t = 's'
       case ('radius', 'width', 'lx', 'ly', 'center', 'rotate_axis', 'rotate_angle', 'young', &
-            'poisson', 'density', 'thickness', 'velocity', 'omega'); t = 'r'
+            'poisson', 'density', 'thickness', 'velocity', 'omega', 'gravity'); t = 'r'
       case ('n_around', 'n_across', 'n_div', 'nx', 'ny'); t = 'i'
       end select
     case ('restraint')

@@ -94,8 +94,9 @@ contains
           if (find_body(b%name) /= i) &
             call add_problem(deck, n, '&body: name '''//trim(b%name)//''' used twice')
         end if
-        call finite(n, '&body '//trim(b%name)//': center, rotate_axis, rotate_angle, velocity '// &
-                    'or omega', [b%center, b%rotate_axis, b%rotate_angle, b%velocity, b%omega])
+        call finite(n, '&body '//trim(b%name)//': center, rotate_axis, rotate_angle, velocity, '// &
+                    'omega or gravity', [b%center, b%rotate_axis, b%rotate_angle, b%velocity, b%omega, &
+                                         b%gravity])
         call positive(n, '&body '//trim(b%name)//': young', b%young)
         call positive(n, '&body '//trim(b%name)//': density', b%density)
         call positive(n, '&body '//trim(b%name)//': thickness', b%thickness)

@@ -70,7 +70,7 @@ contains
     type(mesh_t) :: mesh
     type(error_t), allocatable :: err
     logical :: comps(7), ok
-    integer :: ib, i, n, c
+    integer :: ib, i, n, c, k
     integer, allocatable :: sel(:)
     real(dp), allocatable :: share(:)
     type(body_sets_t) :: sets(size(deck%bodies))
@@ -135,7 +135,9 @@ contains
         end do
       end associate
     end do
-    model%gravity = deck%run%gravity
+    do k = 1, model%nbody
+      model%body(k)%gravity = deck%run%gravity + deck%bodies(k)%gravity
+    end do
   end subroutine build_model
 
   !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),

@@ -20,6 +20,7 @@ module casca_model
     character(len=:), allocatable :: name
     real(dp) :: young = 0, poisson = 0, density = 0, thickness = 0, lam = 0, mu = 0
     integer :: node_first = 0, node_last = -1, elem_first = 0, elem_last = -1
+    real(dp) :: gravity(3) = 0   !< the run's and the body's own [m/s^2]
   end type body_t
 
   type :: model_t
@@ -35,7 +36,6 @@ module casca_model
     real(dp), allocatable :: emass(:, :, :)  !< (20, 20, nelem) scalar element mass
     logical, allocatable :: fixed(:)         !< (ndof) prescribed parameters
     real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
-    real(dp) :: gravity(3) = 0
     real(dp) :: length = 1                   !< size of the scene (bounding-box diagonal)
   end type model_t
 

@@ -87,8 +87,10 @@ contains
       m = model%emass(:, :, e)
       do l = 1, 10
         n = model%conn(l, e)
-        f(dof(n, 1):dof(n, 3)) = f(dof(n, 1):dof(n, 3)) + model%gravity*sum(m(l, 1:10))
-        f(dof(n, 4):dof(n, 6)) = f(dof(n, 4):dof(n, 6)) + model%gravity*sum(m(10 + l, 1:10))
+        associate (g => model%body(model%elem_body(e))%gravity)
+          f(dof(n, 1):dof(n, 3)) = f(dof(n, 1):dof(n, 3)) + g*sum(m(l, 1:10))
+          f(dof(n, 4):dof(n, 6)) = f(dof(n, 4):dof(n, 6)) + g*sum(m(10 + l, 1:10))
+        end associate
       end do
     end do
   end subroutine gravity_load

@@ -102,6 +102,7 @@ contains
     !> the step from (st%q, st%qd, a0): q, qd, qdd
     subroutine attempt()
       real(dp), allocatable :: qs(:), rs(:)
+      allocate (qs(size(st%q)), rs(size(st%q)))   ! (explicitly: gcc 12 warned of the descriptor)
       qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*a0
       rs = st%qd + dt*(1 - g)*a0
       ! predictor: the step taken with zero new acceleration

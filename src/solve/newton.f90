@@ -152,7 +152,7 @@ contains
     !> penetrations added while the set may still change) and their rows
     subroutine constraints(reproject)
       logical, intent(in) :: reproject
-      integer :: added, k
+      integer :: added
       nc = 0
       version = 0
       call timer_start(t_contact)
