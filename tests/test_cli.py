@@ -17,6 +17,8 @@ Asserted about the command line itself (issue 17):
   energy curves, on which gnuplot warns "empty y range") and `casca plot` of its folder exit 0
   with no "empty y range" in their stdout or stderr, and the warning is in the folder's
   gnuplot.log instead (so the scene does provoke it).
+- a misspelt body name (in &restraint, in &contact pairs) or key is named with the nearest
+  one: "(did you mean 'ring2'?)", "(did you mean 'tolerance'?)".
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -172,6 +174,11 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("node set out of range", lambda s: s + "&restraint\n body = 'ring2', nodes = 1, 2, 999, fix = 'y'\n/\n",
      ["&restraint", "nodes(3) = 999", "out of range 1..240"]),
     ("unknown body in a restraint", lambda s: s + "&restraint\n body = 'ring9', fix = 'y'\n/\n", ["ring9", "not a body"]),
+    ("misspelt body in a restraint", lambda s: s + "&restraint\n body = 'rign2', fix = 'y'\n/\n",
+     ["rign2", "not a body", "did you mean 'ring2'?"]),
+    ("misspelt body in the pairs", lambda s: s + "&contact\n pairs = 'ring1', 'rings2'\n/\n",
+     ["pairs(:, 1)", "rings2", "did you mean 'ring2'?"]),
+    ("misspelt key", lambda s: s + "&contact\n tolerence = 1e-6\n/\n", ["&contact", "tolerence", "did you mean 'tolerance'?"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),

@@ -4,7 +4,49 @@
 module casca_deck_lint
   implicit none
   private
-  public :: lint_group, lower
+  public :: lint_group, lower, did_you_mean
+
+  !> Every key of every group and its type: 'r' real, 'i' integer, 'l' logical, 's' string
+  !> (the one list: the lint's check and its suggestions read it)
+  type :: key_t
+    character(len=9) :: group
+    character(len=20) :: name
+    character(len=1) :: type
+  end type key_t
+  type(key_t), parameter :: keys(*) = [ &
+    key_t('run', 'title', 's'), key_t('run', 'analysis', 's'), key_t('run', 'ordering', 's'), &
+    key_t('run', 'dt', 'r'), key_t('run', 't_end', 'r'), key_t('run', 'beta', 'r'), &
+    key_t('run', 'gamma', 'r'), key_t('run', 'newton_tol', 'r'), key_t('run', 'gravity', 'r'), &
+    key_t('run', 'newton_max_iter', 'i'), key_t('run', 'load_steps', 'i'), &
+    key_t('run', 'max_step_cuts', 'i'), key_t('run', 'reuse_factorisation', 'l'), &
+    key_t('run', 'skip_idle_bodies', 'l'), key_t('output', 'dir', 's'), &
+    key_t('output', 'track_body', 's'), key_t('output', 'interval', 'r'), &
+    key_t('output', 'checkpoint_interval', 'r'), key_t('output', 'track', 'r'), &
+    key_t('output', 'vtu', 'l'), key_t('output', 'plots', 'l'), key_t('body', 'name', 's'), &
+    key_t('body', 'mesh', 's'), key_t('body', 'file', 's'), key_t('body', 'radius', 'r'), &
+    key_t('body', 'width', 'r'), key_t('body', 'lx', 'r'), key_t('body', 'ly', 'r'), &
+    key_t('body', 'center', 'r'), key_t('body', 'rotate_axis', 'r'), &
+    key_t('body', 'rotate_angle', 'r'), key_t('body', 'young', 'r'), &
+    key_t('body', 'poisson', 'r'), key_t('body', 'density', 'r'), &
+    key_t('body', 'thickness', 'r'), key_t('body', 'velocity', 'r'), key_t('body', 'omega', 'r'), &
+    key_t('body', 'gravity', 'r'), key_t('body', 'n_around', 'i'), &
+    key_t('body', 'n_across', 'i'), key_t('body', 'n_div', 'i'), key_t('body', 'nx', 'i'), &
+    key_t('body', 'ny', 'i'), key_t('restraint', 'body', 's'), key_t('restraint', 'fix', 's'), &
+    key_t('restraint', 'set', 's'), key_t('restraint', 'box_min', 'r'), &
+    key_t('restraint', 'box_max', 'r'), key_t('restraint', 'nodes', 'i'), &
+    key_t('load', 'body', 's'), key_t('load', 'set', 's'), key_t('load', 'kind', 's'), &
+    key_t('load', 'box_min', 'r'), key_t('load', 'box_max', 'r'), key_t('load', 'force', 'r'), &
+    key_t('load', 'nodes', 'i'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
+    key_t('contact', 'normal', 's'), key_t('contact', 'surface', 's'), &
+    key_t('contact', 'tolerance', 'r'), key_t('contact', 'friction', 'r'), &
+    key_t('contact', 'static_friction', 'r'), key_t('contact', 'pair_friction', 'r'), &
+    key_t('contact', 'pair_static_friction', 'r'), key_t('contact', 'passes', 'i'), &
+    key_t('contact', 'enabled', 'l'), key_t('obstacle', 'name', 's'), &
+    key_t('obstacle', 'shape', 's'), key_t('obstacle', 'bodies', 's'), &
+    key_t('obstacle', 'point', 'r'), key_t('obstacle', 'normal', 'r'), &
+    key_t('obstacle', 'axis', 'r'), key_t('obstacle', 'radius', 'r'), &
+    key_t('obstacle', 'velocity', 'r'), key_t('obstacle', 'friction', 'r'), &
+    key_t('obstacle', 'static_friction', 'r'), key_t('obstacle', 'inside', 'l')]
 
 contains
 
@@ -12,54 +54,13 @@ contains
   pure function key_type(group, key) result(t)
     character(len=*), intent(in) :: group, key
     character(len=1) :: t
+    integer :: k
     t = ' '
-    select case (group)
-    case ('run')
-      select case (key)
-      case ('title', 'analysis', 'ordering'); t = 's'
-      case ('dt', 't_end', 'beta', 'gamma', 'newton_tol', 'gravity'); t = 'r'
-      case ('newton_max_iter', 'load_steps', 'max_step_cuts'); t = 'i'
-      case ('reuse_factorisation', 'skip_idle_bodies'); t = 'l'
-      end select
-    case ('output')
-      select case (key)
-      case ('dir', 'track_body'); t = 's'
-      case ('interval', 'checkpoint_interval', 'track'); t = 'r'
-      case ('vtu', 'plots'); t = 'l'
-      end select
-    case ('body')
-      select case (key)
-      case ('name', 'mesh', 'file'); t = 's'
-      case ('radius', 'width', 'lx', 'ly', 'center', 'rotate_axis', 'rotate_angle', 'young', &
-            'poisson', 'density', 'thickness', 'velocity', 'omega', 'gravity'); t = 'r'
-      case ('n_around', 'n_across', 'n_div', 'nx', 'ny'); t = 'i'
-      end select
-    case ('restraint')
-      select case (key)
-      case ('body', 'fix', 'set'); t = 's'
-      case ('box_min', 'box_max'); t = 'r'
-      case ('nodes'); t = 'i'
-      end select
-    case ('load')
-      select case (key)
-      case ('body', 'set', 'kind'); t = 's'
-      case ('box_min', 'box_max', 'force'); t = 'r'
-      case ('nodes'); t = 'i'
-      end select
-    case ('contact')
-      select case (key)
-      case ('pairs', 'solver', 'normal', 'surface'); t = 's'
-      case ('tolerance', 'friction', 'static_friction', 'pair_friction', 'pair_static_friction'); t = 'r'
-      case ('passes'); t = 'i'
-      case ('enabled'); t = 'l'
-      end select
-    case ('obstacle')
-      select case (key)
-      case ('name', 'shape', 'bodies'); t = 's'
-      case ('point', 'normal', 'axis', 'radius', 'velocity', 'friction', 'static_friction'); t = 'r'
-      case ('inside'); t = 'l'
-      end select
-    end select
+    do k = 1, size(keys)
+      if (keys(k)%group == group .and. keys(k)%name == key) then
+        t = keys(k)%type; return
+      end if
+    end do
   end function key_type
 
   !> Check the group whose '&name' is on line first of text(:). Each problem is returned as
@@ -119,7 +120,7 @@ contains
           if (index(key, '(') > 0) key = key(1:index(key, '(') - 1)
           t = key_type(group, key)
           if (t == ' ') call report(lineof(p), '&'//group//': unknown key '''//key//''''// &
-                                    suggestion(key))
+                                    suggestion(group, key))
           p = k + 1
         else
           call value(item, lineof(p))
@@ -223,28 +224,29 @@ contains
     end do
   end function group_ends
 
-  !> ' (did you mean ''x''?)' for the nearest known key of any group, by edit distance
-  function suggestion(key) result(s)
-    character(len=*), intent(in) :: key
+  !> ' (did you mean ''x''?)' for the nearest key of the group (of any group if none is near)
+  function suggestion(group, key) result(s)
+    character(len=*), intent(in) :: group, key
     character(len=:), allocatable :: s
-    character(len=*), parameter :: all_keys(*) = [character(len=19) :: 'title', 'analysis', &
-      'ordering', 'dt', 't_end', 'beta', 'gamma', 'newton_tol', 'gravity', 'newton_max_iter', &
-      'load_steps', 'max_step_cuts', 'reuse_factorisation', 'skip_idle_bodies', 'dir', &
-      'track_body', 'interval', 'checkpoint_interval', &
-      'track', 'vtu', 'plots', 'name', 'mesh', 'file', 'radius', 'width', 'lx', 'ly', 'center', &
-      'rotate_axis', 'rotate_angle', 'young', 'poisson', 'density', 'thickness', 'velocity', &
-      'omega', 'n_around', 'n_across', 'n_div', 'nx', 'ny', 'body', 'fix', 'box_min', 'box_max', &
-      'force', 'pairs', 'tolerance', 'enabled', 'solver', 'normal', 'nodes', 'set', 'kind']
+    s = did_you_mean(key, pack(keys%name, keys%group == group))
+    if (s == '') s = did_you_mean(key, keys%name)
+  end function suggestion
+
+  !> ' (did you mean ''x''?)' for the candidate nearest to name by edit distance (at most 2
+  !> edits), else ''
+  function did_you_mean(name, candidates) result(s)
+    character(len=*), intent(in) :: name, candidates(:)
+    character(len=:), allocatable :: s
     integer :: i, d, best
     s = ''
     best = 3
-    do i = 1, size(all_keys)
-      d = edit_distance(key, trim(all_keys(i)))
+    do i = 1, size(candidates)
+      d = edit_distance(trim(name), trim(candidates(i)))
       if (d < best) then
-        best = d; s = ' (did you mean '''//trim(all_keys(i))//'''?)'
+        best = d; s = ' (did you mean '''//trim(candidates(i))//'''?)'
       end if
     end do
-  end function suggestion
+  end function did_you_mean
 
   pure integer function edit_distance(a, b) result(d)
     character(len=*), intent(in) :: a, b

@@ -7,6 +7,7 @@ module casca_sanity
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
   use casca_mesh_generators, only: generated_elements, max_generated_elements
   use casca_strings, only: itoa, rtoa
+  use casca_deck_lint, only: did_you_mean
   implicit none
   private
   public :: check_deck, parse_fix
@@ -80,8 +81,7 @@ contains
       call finite(l, '&output: track', reshape(o%track(:, 1:o%ntrack), [3*o%ntrack]))
       do i = 1, o%ntrack
         if (o%track_body(i) /= '' .and. find_body(o%track_body(i)) == 0) &
-          call add_problem(deck, l, '&output: track_body('//itoa(i)//') = '''// &
-                           trim(o%track_body(i))//''' is not a body of the deck')
+          call add_problem(deck, l, '&output: track_body('//itoa(i)//') = '//no_body(o%track_body(i)))
       end do
     end associate
 
@@ -145,7 +145,7 @@ contains
     do i = 1, size(deck%restraints)
       associate (r => deck%restraints(i))
         if (r%body /= '' .and. find_body(r%body) == 0) call add_problem(deck, r%line, &
-          '&restraint: body = '''//trim(r%body)//''' is not a body of the deck')
+          '&restraint: body = '//no_body(r%body))
         if (size(r%nodes) > 0 .and. r%body == '') call add_problem(deck, r%line, &
           '&restraint: nodes needs body = ... (node numbers count within a body)')
         call check_selection(r%line, '&restraint', r%body, r%set, size(r%nodes), r%box_min, r%box_max)
@@ -161,7 +161,7 @@ contains
     do i = 1, size(deck%loads)
       associate (l => deck%loads(i))
         if (l%body /= '' .and. find_body(l%body) == 0) call add_problem(deck, l%line, &
-          '&load: body = '''//trim(l%body)//''' is not a body of the deck')
+          '&load: body = '//no_body(l%body))
         if (size(l%nodes) > 0 .and. l%body == '') call add_problem(deck, l%line, &
           '&load: nodes needs body = ... (node numbers count within a body)')
         call check_selection(l%line, '&load', l%body, l%set, size(l%nodes), l%box_min, l%box_max)
@@ -179,8 +179,8 @@ contains
       do i = 1, 2
         if (find_body(deck%contact%pairs(i, j)) == 0) then
           write (ns, '(i0)') j
-          call add_problem(deck, deck%contact%line, '&contact: pairs(:, '//trim(ns)//') names '''// &
-                           trim(deck%contact%pairs(i, j))//''', which is not a body of the deck')
+          call add_problem(deck, deck%contact%line, '&contact: pairs(:, '//trim(ns)//') = '// &
+                           no_body(deck%contact%pairs(i, j)))
         end if
       end do
     end do
@@ -233,8 +233,8 @@ contains
       if (o%friction /= unset .or. o%static_friction /= unset) call check_friction(o%line, &
         '&obstacle', merge(o%friction, deck%contact%friction, o%friction /= unset), o%static_friction)
       do k = 1, o%nbodies
-        if (find_body(o%bodies(k)) == 0) call add_problem(deck, o%line, '&obstacle: bodies names '''// &
-          trim(o%bodies(k))//''', which is not a body of the deck')
+        if (find_body(o%bodies(k)) == 0) call add_problem(deck, o%line, '&obstacle: bodies = '// &
+          no_body(o%bodies(k)))
       end do
     end subroutine check_obstacle
 
@@ -332,6 +332,13 @@ contains
           ' GB of memory; this machine has '//rtoa(real(physical_memory(), dp)/1e9_dp)//' GB')
     end subroutine check_memory
 
+
+    !> "'x' is not a body of the deck", with the nearest body name if one is near
+    function no_body(name) result(msg)
+      character(len=*), intent(in) :: name
+      character(len=:), allocatable :: msg
+      msg = ''''//trim(name)//''' is not a body of the deck'//did_you_mean(name, deck%bodies%name)
+    end function no_body
 
     integer function find_body(name)
       character(len=*), intent(in) :: name
