@@ -178,7 +178,7 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["rign2", "not a body", "did you mean 'ring2'?"]),
     ("misspelt body in the pairs", lambda s: s + "&contact\n pairs = 'ring1', 'rings2'\n/\n",
      ["pairs(:, 1)", "rings2", "did you mean 'ring2'?"]),
-    ("misspelt key", lambda s: s + "&contact\n tolerence = 1e-6\n/\n", ["&contact", "tolerence", "did you mean 'tolerance'?"]),
+    ("misspelt key in &contact", lambda s: s + "&contact\n tolerence = 1e-6\n/\n", ["&contact", "tolerence", "did you mean 'tolerance'?"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),
