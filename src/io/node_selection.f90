@@ -100,7 +100,7 @@ contains
     integer, intent(in) :: sel(:)
     real(dp), allocatable, intent(out) :: w(:)
     type(error_t), allocatable, intent(out) :: err
-    integer, allocatable :: pos(:), cand(:, :), start(:), list(:)
+    integer, allocatable :: pos(:), cand(:, :), start(:), list(:), lo(:), hi(:)
     real(dp), allocatable :: z(:), gw(:)
     real(dp) :: s, n(4), dn(4), dx(3), x(3, 4), total
     integer :: e, j, k, m, nc, nb, en(4), a
@@ -122,10 +122,15 @@ contains
         cand(:, nc) = [e, j]
       end do
     end do
+    allocate (lo(nc), hi(nc))   ! each candidate's end nodes, low and high
+    do k = 1, nc
+      en = model%conn(edge_nodes(:, cand(2, k)), cand(1, k))
+      lo(k) = min(en(1), en(4)); hi(k) = max(en(1), en(4))
+    end do
     allocate (start(model%nnode + 1), list(nc))
     start = 0
     do k = 1, nc
-      a = low_end(k)
+      a = lo(k)
       start(a + 1) = start(a + 1) + 1
     end do
     start(1) = 1
@@ -136,7 +141,7 @@ contains
       integer :: fill(model%nnode)
       fill = start(1:model%nnode)
       do k = 1, nc
-        a = low_end(k)
+        a = lo(k)
         list(fill(a)) = k
         fill(a) = fill(a) + 1
       end do
@@ -144,8 +149,8 @@ contains
     call gauss_rule(3, z, gw, qerr)
     nb = 0
     do k = 1, nc
-      a = low_end(k)
-      if (count([(high_end(list(m)) == high_end(k), m=start(a), start(a + 1) - 1)]) > 1) cycle
+      a = lo(k)
+      if (count(hi(list(start(a):start(a + 1) - 1)) == hi(k)) > 1) cycle
       nb = nb + 1
       en = model%conn(edge_nodes(:, cand(2, k)), cand(1, k))
       x = model%x0(:, en)
@@ -164,20 +169,6 @@ contains
       return
     end if
     w = w/total
-  contains
-    integer function low_end(c)
-      integer, intent(in) :: c
-      integer :: ee(4)
-      ee = model%conn(edge_nodes(:, cand(2, c)), cand(1, c))
-      low_end = min(ee(1), ee(4))
-    end function low_end
-
-    integer function high_end(c)
-      integer, intent(in) :: c
-      integer :: ee(4)
-      ee = model%conn(edge_nodes(:, cand(2, c)), cand(1, c))
-      high_end = max(ee(1), ee(4))
-    end function high_end
   end subroutine edge_shares
 
   !> Cubic Lagrange functions (and their derivatives) of nodes at s = 0, 1/3, 2/3, 1.
