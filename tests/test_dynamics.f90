@@ -12,7 +12,8 @@ program test_dynamics
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_newmark, only: state_t, newmark_t, newmark_step
+  use casca_newmark, only: state_t, newmark_step
+  use casca_time_scheme, only: scheme_t, newmark_scheme
   use casca_accounting, only: balance_t, account
   use casca_mpi, only: mpi_start, mpi_stop, is_root, n_ranks
   use casca_vectors, only: cross
@@ -86,7 +87,7 @@ contains
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
-    type(newmark_t) :: nm
+    type(scheme_t) :: nm
     real(dp) :: omega, period, w, wold, tcross(64), tc
     real(dp), allocatable :: zero(:)
     integer :: n, ncross, ntip, s
@@ -108,7 +109,7 @@ contains
     opts%tol = 1e-12_dp
     call newton_solve(model, asm, ls, st%q, model%fext, opts, rep, err)
     st%qd = 0; st%qdd = 0; zero = 0
-    nm%beta = 0.25_dp; nm%gamma = 0.5_dp; nm%dt = 2*pi/omega/200
+    nm = newmark_scheme(0.25_dp, 0.5_dp); nm%dt = 2*pi/omega/200
     ncross = 0
     wold = sum(st%q(dof(tip, 3)) - model%x0(3, tip))/ntip
     do s = 1, 800
@@ -144,7 +145,7 @@ contains
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
-    type(newmark_t) :: nm
+    type(scheme_t) :: nm
     type(balance_t) :: b0, b
     real(dp) :: v(3), w(3)
     real(dp), allocatable :: zero(:), q0(:)
@@ -163,7 +164,7 @@ contains
       st%qd(dof(n, 4):dof(n, 6)) = cross(w, model%v0(:, n))
       st%qd(dof(n, 7)) = 0
     end do
-    nm%beta = 0.25_dp; nm%gamma = 0.5_dp; nm%dt = dt
+    nm = newmark_scheme(0.25_dp, 0.5_dp); nm%dt = dt
     opts%tol = 1e-12_dp
     call account(model, asm, st, zero, q0, b0)
     dl = 0; de = 0; dpm = 0

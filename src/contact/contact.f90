@@ -77,7 +77,7 @@ module casca_contact
     real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
     real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
     ! per pair: the impulse on the impactor so far, as the integrator applied it, and the
-    ! force the start acceleration of the next step carries times 1 - gamma [N s, N]
+    ! contact's share of M a at the start of the next step [N s, N]
     real(dp), allocatable :: impulse(:, :), carry(:, :)
     type(target_geometry_t) :: geo
     ! the active set

@@ -6,6 +6,7 @@ module casca_contact_rows
   use casca_model, only: model_t, dof
   use casca_contact, only: contact_t, constraint_t, stick, slip
   use casca_contact_projection, only: constraint_entries, constraint_row, max_row
+  use casca_time_scheme, only: scheme_t
   implicit none
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
@@ -146,41 +147,44 @@ contains
     end do
   end function contact_max_gap
 
-  !> After an accepted step of length dt (Newmark's gamma g): add each pair's impulse on its
-  !> impactor as the integrator applied it, and the moving obstacles' work from it. The
-  !> step changes the momentum by dt ((1 - g) F_start + g F_end) + C^T nu: F_start the
-  !> forces the start acceleration carries (the last step's end forces with their
-  !> acceleration corrections mu, c%carry), less the normal force of the constraints
-  !> released taken out of it (newmark.f90); nu the velocity correction's impulses, in
-  !> row order. (dt F_end summed over the steps is off by Newton's tolerance; this is exact.)
-  subroutine add_step_impulse(c, dt, g, released, nu)
+  !> After an accepted step (scheme ts): add each pair's impulse on its impactor as the
+  !> integrator applied it, and the moving obstacles' work from it. The step changes the
+  !> momentum by dt ((1 - gamma) A_start + gamma A_end) + C^T nu: A_start the contact's share
+  !> of M a at the start (the last step's, with its acceleration corrections mu: c%carry),
+  !> less the normal force of the constraints released taken out of it (newmark.f90);
+  !> A_end = (F_end - alpha_m A_start)/(1 - alpha_m) with F_end the end forces (Newmark:
+  !> A_end = F_end); nu the velocity correction's impulses, in row order. (dt F_end summed
+  !> over the steps is off by Newton's tolerance; this is exact.)
+  subroutine add_step_impulse(c, ts, released, nu)
     type(contact_t), intent(inout) :: c
-    real(dp), intent(in) :: dt, g
+    type(scheme_t), intent(in) :: ts
     type(constraint_t), intent(in) :: released(:)
     real(dp), intent(in) :: nu(:)
-    real(dp) :: j(3, c%npairs), f(3)
+    real(dp) :: j(3, c%npairs), f_end(3, c%npairs), mu(3, c%npairs), dt, g
     integer :: k, r, t
-    j = dt*c%carry
+    dt = ts%dt; g = ts%gamma
     do k = 1, size(released)
       associate (a => released(k))
-        j(:, a%pair) = j(:, a%pair) - dt*(1 - g)*(a%mu - a%lambda)*a%n
+        c%carry(:, a%pair) = c%carry(:, a%pair) - (a%mu - a%lambda)*a%n
       end associate
     end do
-    c%carry = 0
+    j = 0; f_end = 0; mu = 0
     r = 0
     do k = 1, c%nact
       associate (a => c%act(k))
-        f = node_force(c, a)
-        j(:, a%pair) = j(:, a%pair) + dt*g*f + nu(r + 1)*a%n
-        f = f + a%mu*a%n
+        f_end(:, a%pair) = f_end(:, a%pair) + node_force(c, a)
+        j(:, a%pair) = j(:, a%pair) + nu(r + 1)*a%n
+        mu(:, a%pair) = mu(:, a%pair) + a%mu*a%n
         if (a%grip == stick) then
           j(:, a%pair) = j(:, a%pair) + nu(r + 2)*a%t(:, 1) + nu(r + 3)*a%t(:, 2)
-          f = f + a%mut(1)*a%t(:, 1) + a%mut(2)*a%t(:, 2)
+          mu(:, a%pair) = mu(:, a%pair) + a%mut(1)*a%t(:, 1) + a%mut(2)*a%t(:, 2)
         end if
-        c%carry(:, a%pair) = c%carry(:, a%pair) + (1 - g)*f
         r = r + constraint_nkinds(a)
       end associate
     end do
+    f_end = ts%end_force_weight(f_end, c%carry)
+    j = j + dt*((1 - g)*c%carry + g*f_end)
+    c%carry = f_end + mu
     c%impulse = c%impulse + j
     do k = 1, c%npairs
       t = c%pair(2, k)

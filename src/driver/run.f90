@@ -11,7 +11,8 @@ module casca_run
   use casca_linear_system, only: linear_system_t
   use casca_mass_solver, only: mass_setup
   use casca_newton, only: newton_opts_t, newton_report_t
-  use casca_newmark, only: state_t, newmark_t, newmark_step, static_solve
+  use casca_newmark, only: state_t, newmark_step, static_solve
+  use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
@@ -51,7 +52,7 @@ module casca_run
     type(newton_opts_t) :: opts
     type(newton_report_t) :: rep
     type(state_t) :: st
-    type(newmark_t) :: nm
+    type(scheme_t) :: nm                        !< the time integration scheme
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
@@ -238,7 +239,11 @@ contains
     real(dp), allocatable :: q_before(:), qd_before(:)
     integer :: k
     associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm, rep => r%rep)
-      nm%beta = deck%run%beta; nm%gamma = deck%run%gamma
+      if (deck%run%rho_inf /= unset) then
+        nm = alpha_scheme(deck%run%rho_inf)
+      else
+        nm = newmark_scheme(deck%run%beta, deck%run%gamma)
+      end if
       dt = deck%run%dt
       interval = deck%output%interval
       if (interval == unset) interval = deck%run%t_end/100
@@ -550,8 +555,9 @@ contains
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
     if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') write (0, '(a)') &
-      'hint: gamma = 0.5 keeps the shells'' fastest vibrations undamped, which can stall Newton; '// &
-      'beta = 0.3025, gamma = 0.6 damps them (or the thesis'' beta = 1, gamma = 1.5)'
+      'hint: '//r%nm%describe()//' keeps the shells'' fastest vibrations undamped, which can '// &
+      'stall Newton; rho_inf = 0.8 (generalized-alpha) damps them, second order '// &
+      '(or beta = 0.3025, gamma = 0.6; or the thesis'' beta = 1, gamma = 1.5)'
     r%code = exit_solver
   end subroutine give_up
 

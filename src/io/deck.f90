@@ -37,6 +37,7 @@ module casca_deck
     character(len=16) :: analysis = 'dynamic'   !< 'dynamic' or 'static'
     real(dp) :: dt = unset, t_end = unset
     real(dp) :: beta = 1.0_dp, gamma = 1.5_dp  !< the thesis' choice for impact
+    real(dp) :: rho_inf = unset                 !< given: generalized-alpha (not beta, gamma)
     real(dp) :: newton_tol = 1e-9_dp
     integer :: newton_max_iter = 20
     integer :: load_steps = 10
@@ -436,15 +437,16 @@ contains
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
     character(len=long) :: title, analysis, ordering
-    real(dp) :: dt, t_end, beta, gamma, newton_tol, gravity(3)
+    real(dp) :: dt, t_end, beta, gamma, rho_inf, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
     logical :: reuse_factorisation, skip_idle_bodies
     character(len=256) :: msg
-    namelist /run/ title, analysis, dt, t_end, beta, gamma, newton_tol, newton_max_iter, &
+    namelist /run/ title, analysis, dt, t_end, beta, gamma, rho_inf, newton_tol, newton_max_iter, &
       load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies
     associate (c => deck%run)
-      title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = c%beta
-      gamma = c%gamma; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
+      ! (beta and gamma read as unset: given with rho_inf they are refused, not overridden)
+      title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = unset
+      gamma = unset; rho_inf = c%rho_inf; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
       ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
       skip_idle_bodies = c%skip_idle_bodies
@@ -458,8 +460,12 @@ contains
       call take(deck, line, '&run: title', title, c%title)
       call take(deck, line, '&run: analysis', lower(analysis), c%analysis)
       call take(deck, line, '&run: ordering', lower(ordering), c%ordering)
-      c%dt = dt; c%t_end = t_end; c%beta = beta
-      c%gamma = gamma; c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
+      c%dt = dt; c%t_end = t_end; c%rho_inf = rho_inf
+      if (rho_inf /= unset .and. (beta /= unset .or. gamma /= unset)) call add_problem(deck, line, &
+        '&run: give either rho_inf (generalized-alpha) or beta and gamma (Newmark), not both')
+      if (beta /= unset) c%beta = beta
+      if (gamma /= unset) c%gamma = gamma
+      c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
       c%reuse_factorisation = reuse_factorisation
       c%skip_idle_bodies = skip_idle_bodies

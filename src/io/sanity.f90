@@ -49,6 +49,8 @@ contains
         call finite(l, '&run: gamma', [r%gamma])
         if (r%gamma < 0.5_dp) call add_problem(deck, l, &
           '&run: gamma must be >= 0.5 (gamma < 1/2 makes Newmark unstable)')
+        if (r%rho_inf /= unset .and. .not. (r%rho_inf >= 0 .and. r%rho_inf <= 1)) &
+          call add_problem(deck, l, '&run: rho_inf must be in 0..1 (got '//rtoa(r%rho_inf)//')')
       case ('static')
         if (r%load_steps < 1) call add_problem(deck, l, '&run: load_steps must be >= 1')
       case default

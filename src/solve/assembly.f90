@@ -223,21 +223,27 @@ contains
   end subroutine assembly_setup
 
   !> r = f_int(q) + cm M q - M qs  (qs, cm only in dynamics), summed over ranks, and
-  !> (want_k) asm%a = H + cm M. energy: strain energy of q (sum over ranks). The tangent goes
+  !> (want_k) asm%a = H + cm M. energy: strain energy of q (sum over ranks). With qn and af
+  !> (generalized-alpha, casca_time_scheme) f_int and H are taken at (1 - af) q + af qn and
+  !> H is scaled by 1 - af, its derivative with respect to q. The tangent goes
   !> to the blocks' MUMPS instances, so with want_k the elements are this rank's of its blocks;
   !> without, any split will do and the elements dealt round keep the ranks evenly loaded.
-  subroutine assemble(model, asm, q, want_k, r, energy, cm, qs)
+  subroutine assemble(model, asm, q, want_k, r, energy, cm, qs, qn, af)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     real(dp), intent(in) :: q(:)
     logical, intent(in) :: want_k
     real(dp), intent(out) :: r(:), energy
-    real(dp), intent(in), optional :: cm, qs(:)
+    real(dp), intent(in), optional :: cm, qs(:), qn(:), af
     real(dp) :: qe(7, 10), fe(ndof_elem), ke(ndof_elem, ndof_elem), ue, me(20, 20), acc(3, 20)
+    real(dp) :: w
     integer :: d(ndof_elem), i, e, b, p, l
-    logical :: dynamic
+    logical :: dynamic, blend
 
     dynamic = present(cm)
+    w = 0
+    if (present(af)) w = af
+    blend = w /= 0 .and. present(qn)
     r = 0; energy = 0
     do i = 1, merge(size(asm%elems), size(asm%dealt), want_k)
       if (want_k) then
@@ -247,11 +253,16 @@ contains
       end if
       d = element_dofs(model, e)
       qe = reshape(q(d), [7, 10])
+      if (blend) qe = (1 - w)*qe + w*reshape(qn(d), [7, 10])
       b = model%elem_body(e)
       call shell_energy_force(model%rule, model%body(b)%thickness, model%body(b)%lam, &
                               model%body(b)%mu, model%binv(:, :, :, e), model%wdet(:, e), qe, &
                               want_k, ue, fe, ke)
       energy = energy + ue
+      if (blend) then
+        if (want_k) ke = (1 - w)*ke
+        qe = reshape(q(d), [7, 10])   ! (the inertia is of the end of the step)
+      end if
       if (dynamic) then
         ! inertia of the vector parameters (Y^l, G^l): M (cm q - qs), tangent cm M
         me = model%emass(:, :, e)

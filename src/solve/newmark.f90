@@ -1,5 +1,6 @@
-!> Newmark time stepping (thesis section 3.2) with Newton at every step, and load-stepped
-!> statics. The mass is constant, so the inertia enters the residual as M (q/(beta dt^2) - Q_s).
+!> Time stepping (thesis section 3.2: Newmark; or generalized-alpha, casca_time_scheme) with
+!> Newton at every step, and load-stepped statics. The mass is constant, so the inertia enters
+!> the residual as M (cm q - qs).
 module casca_newmark
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -13,20 +14,16 @@ module casca_newmark
   use casca_contact_friction, only: friction_step_done
   use casca_contact_rows, only: add_step_impulse, contact_nrows
   use casca_timers, only: timer_start, timer_stop, t_contact
+  use casca_time_scheme, only: scheme_t
   implicit none
   private
-  public :: state_t, newmark_t, newmark_step, static_solve
+  public :: state_t, newmark_step, static_solve
 
   type :: state_t
     real(dp) :: t = 0
     integer :: step = 0
     real(dp), allocatable :: q(:), qd(:), qdd(:)
   end type state_t
-
-  type :: newmark_t
-    real(dp) :: beta = 1.0_dp, gamma = 1.5_dp   !< the thesis' dissipative choice for impact
-    real(dp) :: dt = 0
-  end type newmark_t
 
 contains
 
@@ -43,7 +40,7 @@ contains
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     type(linear_system_t), intent(inout) :: ls
-    type(newmark_t), intent(in) :: nm
+    type(scheme_t), intent(in) :: nm
     real(dp), intent(in) :: fext(:)
     type(newton_opts_t), intent(in) :: opts
     type(state_t), intent(inout) :: st
@@ -52,11 +49,12 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:)
     type(constraint_t), allocatable :: before(:), released(:)
-    real(dp) :: b, dt, g
+    real(dp) :: dt, g
     integer :: k, iters
 
-    b = nm%beta; g = nm%gamma; dt = nm%dt
-    a0 = st%qdd
+    g = nm%gamma; dt = nm%dt
+    allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
+    allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
@@ -92,7 +90,7 @@ contains
       end if
     end if
     if (present(contact)) then   ! (before friction turns its slip directions)
-      call add_step_impulse(contact, dt, g, released, nu)
+      call add_step_impulse(contact, nm, released, nu)
       call friction_step_done(contact)
     end if
     st%q = q; st%qd = qd; st%qdd = qdd
@@ -101,19 +99,17 @@ contains
   contains
     !> the step from (st%q, st%qd, a0): q, qd, qdd
     subroutine attempt()
-      real(dp), allocatable :: qs(:), rs(:)
-      allocate (qs(size(st%q)), rs(size(st%q)))   ! (explicitly: gcc 12 warned of the descriptor)
-      qs = st%q/(b*dt*dt) + st%qd/(b*dt) + (0.5_dp/b - 1)*a0
-      rs = st%qd + dt*(1 - g)*a0
-      ! predictor: the step taken with zero new acceleration
-      q = st%q + dt*st%qd + dt*dt*(0.5_dp - b)*a0
+      real(dp), allocatable :: qs(:)
+      real(dp) :: cm
+      allocate (qs(size(st%q)))
+      call nm%inertia(st%q, st%qd, a0, cm, qs)
+      call nm%predictor(st%q, st%qd, a0, q)
       where (model%fixed) q = st%q
-      call newton_solve(model, asm, ls, q, fext, opts, rep, err, 1/(b*dt*dt), qs, contact)
+      call newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, st%q, nm%alpha_f)
       if (.not. allocated(err) .and. .not. rep%converged) &
         call fatal_error(err, 'Newton did not converge')
       if (allocated(err)) return
-      qdd = q/(b*dt*dt) - qs
-      qd = rs + g*dt*qdd
+      call nm%update(st%q, st%qd, a0, q, qd, qdd)
       if (present(contact)) then   ! (on failure the state is left as it was)
         call timer_start(t_contact)
         if (allocated(nu)) deallocate (nu)

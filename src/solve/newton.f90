@@ -72,7 +72,7 @@ module casca_newton
 contains
 
   !> On failure (err allocated) q and the contact's active set are as they were at entry.
-  subroutine newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact)
+  subroutine newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, qn, af)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     type(linear_system_t), intent(inout) :: ls
@@ -83,6 +83,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: cm, qs(:)
     type(contact_t), intent(inout), optional :: contact
+    real(dp), intent(in), optional :: qn(:), af   !< generalized-alpha: f_int at (1-af) q + af qn
     real(dp), allocatable :: r(:), res(:), q_entry(:)
     type(constraint_t), allocatable :: act_entry(:)
     type(rows_t) :: rows
@@ -112,7 +113,7 @@ contains
       if (allocated(err)) exit
       fresh = refresh_needed()
       call timer_start(t_assembly)
-      call assemble(model, asm, q, fresh, r, rep%energy, cm, qs)
+      call assemble(model, asm, q, fresh, r, rep%energy, cm, qs, qn, af)
       r = r - fext
       call timer_stop(t_assembly)
       if (fresh) then

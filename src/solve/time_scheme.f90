@@ -1,0 +1,110 @@
+!> The time integration scheme, in one place: Newmark (beta, gamma; the thesis' 1, 1.5 by
+!> default) and generalized-alpha (Chung & Hulbert 1993) from the user's rho_inf, as one
+!> family. Everything that steps in time (the Newton step, the idle bodies, the impulse
+!> accounting) asks this type rather than knowing the formulas.
+!>
+!> The equation of motion holds at the alpha levels,
+!>     M [(1 - alpha_m) a_{n+1} + alpha_m a_n] + f_int(q_af) + C^T Lambda = F,
+!>     q_af = (1 - alpha_f) q_{n+1} + alpha_f q_n,
+!> with Newmark's relations for q_{n+1}, v_{n+1}; alpha_m = alpha_f = 0 is Newmark. The
+!> internal force is taken at the blended configuration q_af (the "midpoint" form, which
+!> Erlicher, Bonaventura & Bursi 2002 show second order like the weighted-force form) because
+!> it keeps the angular momentum: at rho_inf = 1 (alpha_m = alpha_f = 1/2, beta = 1/4,
+!> gamma = 1/2) the scheme is the implicit midpoint rule, and as f_int is the gradient of a
+!> rotation-invariant energy and M is isotropic (m (x) I3), the linear and angular momentum
+!> of a free body are kept exactly (docs/method.md). The contact multiplier Lambda is one
+!> unknown at the alpha level, acting along the rows at q_{n+1}, where the gap is closed.
+module casca_time_scheme
+  use casca_kinds, only: dp
+  implicit none
+  private
+  public :: scheme_t, newmark_scheme, alpha_scheme
+
+  type :: scheme_t
+    real(dp) :: beta = 1.0_dp, gamma = 1.5_dp  !< the thesis' dissipative choice for impact
+    real(dp) :: alpha_m = 0, alpha_f = 0       !< 0, 0: Newmark
+    real(dp) :: rho_inf = -1                   !< < 0: Newmark (not generalized-alpha)
+    real(dp) :: dt = 0
+  contains
+    procedure :: inertia
+    procedure :: predictor
+    procedure :: update
+    procedure :: end_force_weight
+    procedure :: describe
+  end type scheme_t
+
+contains
+
+  pure function newmark_scheme(beta, gamma) result(s)
+    real(dp), intent(in) :: beta, gamma
+    type(scheme_t) :: s
+    s%beta = beta; s%gamma = gamma
+  end function newmark_scheme
+
+  !> Chung & Hulbert's optimal parameters for the spectral radius rho_inf at infinite
+  !> frequency (0 <= rho_inf <= 1): second order, high frequencies damped to rho_inf
+  pure function alpha_scheme(rho_inf) result(s)
+    real(dp), intent(in) :: rho_inf
+    type(scheme_t) :: s
+    s%rho_inf = rho_inf
+    s%alpha_m = (2*rho_inf - 1)/(rho_inf + 1)
+    s%alpha_f = rho_inf/(rho_inf + 1)
+    s%gamma = 0.5_dp - s%alpha_m + s%alpha_f
+    s%beta = 0.25_dp*(1 - s%alpha_m + s%alpha_f)**2
+  end function alpha_scheme
+
+  !> The inertia of the residual as cm M q - M qs (casca_assembly): from the step's start
+  !> (q, v, a) with a_{n+1} = q_{n+1}/(beta dt^2) - [q/(beta dt^2) + v/(beta dt) + (1/(2 beta) - 1) a]
+  pure subroutine inertia(s, q, v, a, cm, qs)
+    class(scheme_t), intent(in) :: s
+    real(dp), intent(in) :: q(:), v(:), a(:)
+    real(dp), intent(out) :: cm, qs(:)
+    real(dp) :: b, dt
+    b = s%beta; dt = s%dt
+    cm = (1 - s%alpha_m)/(b*dt*dt)
+    qs = (1 - s%alpha_m)*(q/(b*dt*dt) + v/(b*dt) + (0.5_dp/b - 1)*a) - s%alpha_m*a
+  end subroutine inertia
+
+  !> The first iterate: the step taken with zero new acceleration
+  pure subroutine predictor(s, q, v, a, qp)
+    class(scheme_t), intent(in) :: s
+    real(dp), intent(in) :: q(:), v(:), a(:)
+    real(dp), intent(out) :: qp(:)
+    qp = q + s%dt*v + s%dt*s%dt*(0.5_dp - s%beta)*a
+  end subroutine predictor
+
+  !> Newmark's relations: the end acceleration and velocity of the step q -> q1 from its
+  !> start (q, v, a)
+  pure subroutine update(s, q, v, a, q1, v1, a1)
+    class(scheme_t), intent(in) :: s
+    real(dp), intent(in) :: q(:), v(:), a(:), q1(:)
+    real(dp), intent(out) :: v1(:), a1(:)
+    real(dp) :: b, dt
+    b = s%beta; dt = s%dt
+    a1 = (q1 - q - dt*v)/(b*dt*dt) - (0.5_dp/b - 1)*a
+    v1 = v + dt*((1 - s%gamma)*a + s%gamma*a1)
+  end subroutine update
+
+  !> A force F acting at the alpha level, with the start's share A of M a, gives the end
+  !> acceleration's share (F - alpha_m A)/(1 - alpha_m) (Newmark: F): the impulse accounting's
+  !> weights (rows.f90)
+  elemental real(dp) function end_force_weight(s, f, a_start) result(w)
+    class(scheme_t), intent(in) :: s
+    real(dp), intent(in) :: f, a_start
+    w = (f - s%alpha_m*a_start)/(1 - s%alpha_m)
+  end function end_force_weight
+
+  !> e.g. "generalized-alpha, rho_inf 0.8" or "Newmark beta 1, gamma 1.5"
+  function describe(s) result(str)
+    class(scheme_t), intent(in) :: s
+    character(len=:), allocatable :: str
+    character(len=80) :: buf
+    if (s%rho_inf >= 0) then
+      write (buf, '(a,g0.4,a)') 'generalized-alpha (rho_inf ', s%rho_inf, ')'
+    else
+      write (buf, '(a,g0.4,a,g0.4)') 'Newmark (beta ', s%beta, ', gamma ', s%gamma
+      buf = trim(buf)//')'
+    end if
+    str = trim(buf)
+  end function describe
+end module casca_time_scheme
