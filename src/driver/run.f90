@@ -13,6 +13,8 @@ module casca_run
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_step, static_solve
   use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
+  use casca_step_control, only: step_control_t, local_error, next_step_ratio
+  use casca_step_size, only: time_to_contact, same_active_set
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
@@ -53,6 +55,9 @@ module casca_run
     type(newton_report_t) :: rep
     type(state_t) :: st
     type(scheme_t) :: nm                        !< the time integration scheme
+    type(step_control_t) :: sc                  !< steps by an error estimate (tol > 0)
+    real(dp) :: dt_try = 0                      !< with sc: the next step's length
+    logical :: landing = .false.                !< this step ends at a predicted contact
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
@@ -237,6 +242,8 @@ contains
     type(run_t), intent(inout) :: r
     real(dp) :: interval, next_frame, next_ckpt, dt
     real(dp), allocatable :: q_before(:), qd_before(:)
+    type(state_t) :: st_before
+    type(contact_t), allocatable :: contact_before
     integer :: k
     associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm, rep => r%rep)
       if (deck%run%rho_inf /= unset) then
@@ -245,6 +252,13 @@ contains
         nm = newmark_scheme(deck%run%beta, deck%run%gamma)
       end if
       dt = deck%run%dt
+      if (deck%run%tolerance /= unset) then
+        r%sc%tol = deck%run%tolerance
+        r%sc%length = model%length
+        if (deck%run%tolerance_length /= unset) r%sc%length = deck%run%tolerance_length
+        r%sc%dt_min = dt/2**deck%run%max_step_cuts
+        if (r%dt_try == 0) r%dt_try = dt
+      end if
       interval = deck%output%interval
       if (interval == unset) interval = deck%run%t_end/100
       interval = max(interval, dt)
@@ -271,27 +285,43 @@ contains
       allocate (r%frozen(model%ndof), r%idle(model%nbody))
       r%frozen = .false.; r%idle = .false.
       do while (st%t < deck%run%t_end - 1e-9_dp*dt)
-        nm%dt = min(dt/2**r%level, deck%run%t_end - st%t)
+        nm%dt = step_length(r, next_frame)
         if (deck%run%skip_idle_bodies) call update_frozen(r)
         if (allocated(r%err)) then
           call give_up(r, r%err%message); return
         end if
         q_before = st%q; qd_before = st%qd
+        if (r%sc%tol > 0) then   ! (to take the step again)
+          st_before = st
+          if (allocated(r%contact)) contact_before = r%contact
+        end if
         call newmark_step(model, r%asm, r%ls, nm, r%fext, r%opts, st, rep, r%err, r%contact)
         if (allocated(r%err)) then
           if (r%level < deck%run%max_step_cuts) then
             r%level = r%level + 1   ! the state is unchanged: retry with half the step
+            r%dt_try = nm%dt/2
             if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
-              dt/2**r%level, ': ', r%err%message
+              merge(r%dt_try, dt/2**r%level, r%sc%tol > 0), ': ', r%err%message
             deallocate (r%err)
             cycle
           end if
           call give_up(r, r%err%message)
           return
         end if
+        if (r%sc%tol > 0) then
+          if (.not. step_accepted(r, st_before, contact_before)) then
+            st = st_before
+            if (allocated(r%contact)) r%contact = contact_before
+            cycle
+          end if
+        end if
         r%total_newton = r%total_newton + rep%iters
         if (any(r%idle)) call advance_idle(model, r%idle, nm%dt, q_before, qd_before, st%q, st%qd, st%qdd)
-        if (r%level > 0 .and. rep%iters <= 3) r%level = r%level - 1   ! Newton is at ease: grow back
+        if (r%sc%tol > 0) then
+          r%level = 0
+        else if (r%level > 0 .and. rep%iters <= 3) then
+          r%level = r%level - 1   ! Newton is at ease: grow back
+        end if
         call timer_start(t_account)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
         call timer_stop(t_account)
@@ -344,6 +374,54 @@ contains
     call checkpoint(r)
     call finish(r)
   end subroutine static_run
+
+  !> The next step: the deck's dt halved level times, or with the error control the length it
+  !> chose, ended at the next frame and at the predicted time of first contact
+  real(dp) function step_length(r, next_frame) result(h)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(in) :: next_frame
+    real(dp) :: hit
+    associate (st => r%st, t_end => r%deck%run%t_end)
+      if (r%sc%tol <= 0) then
+        h = min(r%deck%run%dt/2**r%level, t_end - st%t)
+        return
+      end if
+      ! equal steps to the next frame (or the end): no sliver of a step before it
+      h = max(min(next_frame, t_end) - st%t, r%sc%dt_min)
+      h = h/ceiling(h/r%dt_try - 1e-9_dp)
+      r%landing = .false.
+      if (.not. allocated(r%contact)) return
+      r%contact%time = st%t
+      hit = time_to_contact(r%contact, r%model, st%q, st%qd, h)
+      if (hit < h) then
+        h = max(hit, r%sc%dt_min)
+        r%landing = .true.
+      end if
+    end associate
+  end function step_length
+
+  !> With the error control: is the step just taken within the tolerance (or below the
+  !> shortest step, or one whose contact set changed)? Sets the next step's length.
+  logical function step_accepted(r, before, contact_before) result(ok)
+    type(run_t), intent(inout) :: r
+    type(state_t), intent(in) :: before
+    type(contact_t), intent(in), optional :: contact_before
+    real(dp) :: err, ratio, h
+    logical :: same
+    h = r%nm%dt
+    err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd)
+    ratio = next_step_ratio(r%sc, err)
+    same = .true.
+    if (present(contact_before)) same = same_active_set(contact_before, r%contact)
+    ok = err <= 1 .or. h <= r%sc%dt_min .or. .not. same
+    if (ok .and. ratio >= 1 .and. h < r%dt_try) then
+      continue   ! (a step ended early by a frame or a contact: dt_try stands)
+    else
+      r%dt_try = max(h*ratio, r%sc%dt_min)
+    end if
+    ! past an onset the contact sets the pace: the deck's dt, grown as the error allows
+    if (r%landing .or. .not. same) r%dt_try = min(r%dt_try, r%deck%run%dt)
+  end function step_accepted
 
   !> Leave the bodies that need no solving this step out of the equations (re-analysed
   !> only when that set changes).

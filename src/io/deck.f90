@@ -38,6 +38,8 @@ module casca_deck
     real(dp) :: dt = unset, t_end = unset
     real(dp) :: beta = 1.0_dp, gamma = 1.5_dp  !< the thesis' choice for impact
     real(dp) :: rho_inf = unset                 !< given: generalized-alpha (not beta, gamma)
+    real(dp) :: tolerance = unset               !< given: steps chosen by the local error
+    real(dp) :: tolerance_length = unset        !< what tolerance is relative to (scene size)
     real(dp) :: newton_tol = 1e-9_dp
     integer :: newton_max_iter = 20
     integer :: load_steps = 10
@@ -437,16 +439,17 @@ contains
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
     character(len=long) :: title, analysis, ordering
-    real(dp) :: dt, t_end, beta, gamma, rho_inf, newton_tol, gravity(3)
+    real(dp) :: dt, t_end, beta, gamma, rho_inf, tolerance, tolerance_length, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
     logical :: reuse_factorisation, skip_idle_bodies
     character(len=256) :: msg
-    namelist /run/ title, analysis, dt, t_end, beta, gamma, rho_inf, newton_tol, newton_max_iter, &
-      load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies
+    namelist /run/ title, analysis, dt, t_end, beta, gamma, rho_inf, tolerance, tolerance_length, &
+      newton_tol, newton_max_iter, load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies
     associate (c => deck%run)
       ! (beta and gamma read as unset: given with rho_inf they are refused, not overridden)
       title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = unset
-      gamma = unset; rho_inf = c%rho_inf; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
+      gamma = unset; rho_inf = c%rho_inf; tolerance = c%tolerance
+      tolerance_length = c%tolerance_length; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
       ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
       skip_idle_bodies = c%skip_idle_bodies
@@ -461,6 +464,7 @@ contains
       call take(deck, line, '&run: analysis', lower(analysis), c%analysis)
       call take(deck, line, '&run: ordering', lower(ordering), c%ordering)
       c%dt = dt; c%t_end = t_end; c%rho_inf = rho_inf
+      c%tolerance = tolerance; c%tolerance_length = tolerance_length
       if (rho_inf /= unset .and. (beta /= unset .or. gamma /= unset)) call add_problem(deck, line, &
         '&run: give either rho_inf (generalized-alpha) or beta and gamma (Newmark), not both')
       if (beta /= unset) c%beta = beta

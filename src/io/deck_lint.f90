@@ -17,7 +17,8 @@ module casca_deck_lint
     key_t('run', 'title', 's'), key_t('run', 'analysis', 's'), key_t('run', 'ordering', 's'), &
     key_t('run', 'dt', 'r'), key_t('run', 't_end', 'r'), key_t('run', 'beta', 'r'), &
     key_t('run', 'gamma', 'r'), key_t('run', 'rho_inf', 'r'), key_t('run', 'newton_tol', 'r'), &
-    key_t('run', 'gravity', 'r'), &
+    key_t('run', 'gravity', 'r'), key_t('run', 'tolerance', 'r'), &
+    key_t('run', 'tolerance_length', 'r'), &
     key_t('run', 'newton_max_iter', 'i'), key_t('run', 'load_steps', 'i'), &
     key_t('run', 'max_step_cuts', 'i'), key_t('run', 'reuse_factorisation', 'l'), &
     key_t('run', 'skip_idle_bodies', 'l'), key_t('output', 'dir', 's'), &

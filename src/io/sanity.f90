@@ -51,6 +51,8 @@ contains
           '&run: gamma must be >= 0.5 (gamma < 1/2 makes Newmark unstable)')
         if (r%rho_inf /= unset .and. .not. (r%rho_inf >= 0 .and. r%rho_inf <= 1)) &
           call add_problem(deck, l, '&run: rho_inf must be in 0..1 (got '//rtoa(r%rho_inf)//')')
+        if (r%tolerance /= unset) call positive(l, '&run: tolerance', r%tolerance)
+        if (r%tolerance_length /= unset) call positive(l, '&run: tolerance_length', r%tolerance_length)
       case ('static')
         if (r%load_steps < 1) call add_problem(deck, l, '&run: load_steps must be >= 1')
       case default

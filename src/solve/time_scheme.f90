@@ -30,6 +30,7 @@ module casca_time_scheme
     procedure :: predictor
     procedure :: update
     procedure :: end_force_weight
+    procedure :: error_coefficient
     procedure :: describe
   end type scheme_t
 
@@ -93,6 +94,17 @@ contains
     real(dp), intent(in) :: f, a_start
     w = (f - s%alpha_m*a_start)/(1 - s%alpha_m)
   end function end_force_weight
+
+  !> c of the local error estimate c dt^2 |a_{n+1} - a_n| (a length): the position's
+  !> (Zienkiewicz & Xie 1991: beta - 1/6, plus (alpha_m - alpha_f)/2 for generalized-alpha,
+  !> whose a tracks the physical one at t + (alpha_m - alpha_f) dt), or, when gamma is not the
+  !> second-order one (the thesis' 1.5), the velocity's (gamma - 1/2 + alpha_m - alpha_f) dt
+  !> |a_{n+1} - a_n| times dt, whichever is larger
+  elemental real(dp) function error_coefficient(s) result(c)
+    class(scheme_t), intent(in) :: s
+    c = max(abs(s%beta - 1/6._dp + 0.5_dp*(s%alpha_m - s%alpha_f)), &
+            abs(s%gamma - 0.5_dp + s%alpha_m - s%alpha_f))
+  end function error_coefficient
 
   !> e.g. "generalized-alpha, rho_inf 0.8" or "Newmark beta 1, gamma 1.5"
   function describe(s) result(str)

@@ -1,0 +1,64 @@
+!> The length of the next step of a run: fixed (the deck's dt, halved after a failed step and
+!> grown back when Newton is at ease) or chosen by the error estimate (&run tolerance,
+!> casca_step_control), ended at output frames and at the predicted time of first contact so
+!> that neither is stepped over.
+module casca_step_size
+  use casca_kinds, only: dp
+  use casca_model, only: model_t, dof
+  use casca_contact, only: contact_t
+  use casca_pair_gaps, only: pair_gap_t, pair_gaps
+  use casca_free_flight, only: clear_near_contact
+  implicit none
+  private
+  public :: time_to_contact, same_active_set
+
+contains
+
+  !> The earliest time to contact of the pairs (straight-line motion from the gaps and closing
+  !> speeds at the closest approaches, casca_pair_gaps) when no constraint is active and a
+  !> body could reach another within two steps of dt; huge when none is predicted. Moving
+  !> obstacles are left out (pair_gaps places them where they start).
+  real(dp) function time_to_contact(c, model, q, qd, dt) result(t)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:), qd(:), dt
+    type(pair_gap_t), allocatable :: pg(:)
+    logical :: far(model%nbody)
+    integer :: k
+    t = huge(1._dp)
+    if (c%nact > 0) return
+    if (any([(norm2(c%obstacle(k)%velocity) > 0, k=1, size(c%obstacle))])) return
+    far = .true.
+    call clear_near_contact(model, q, qd, dt, c, far)
+    if (all(far)) return
+    pg = pair_gaps(c, model, nodal(1), nodal(4), reshape(qd(idx(1)), [3, model%nnode]))
+    do k = 1, size(pg)
+      if (pg(k)%time >= 0) t = min(t, pg(k)%time)
+    end do
+  contains
+    !> the 3 components from the first at every node, as (3, nnode)
+    function nodal(first) result(x)
+      integer, intent(in) :: first
+      real(dp) :: x(3, model%nnode)
+      x = reshape(q(idx(first)), [3, model%nnode])
+    end function nodal
+    function idx(first) result(i)
+      integer, intent(in) :: first
+      integer :: i(3*model%nnode), n, m
+      i = [((dof(n, m), m=first, first + 2), n=1, model%nnode)]
+    end function idx
+  end function time_to_contact
+
+  !> The same constraints (node and pair) before and after a step
+  pure logical function same_active_set(a, b)
+    type(contact_t), intent(in) :: a, b
+    integer :: k
+    same_active_set = a%nact == b%nact
+    if (.not. same_active_set) return
+    do k = 1, a%nact
+      same_active_set = any(b%act(1:b%nact)%node == a%act(k)%node .and. &
+                            b%act(1:b%nact)%pair == a%act(k)%pair)
+      if (.not. same_active_set) return
+    end do
+  end function same_active_set
+end module casca_step_size

@@ -1,0 +1,104 @@
+"""Generalized-alpha and steps chosen by an error estimate, end to end (issues 14 and 18).
+
+usage: test_time_integration.py CASCA MESH_DIR WORK_DIR
+
+Scenes on the thesis ring (R 1 m, 0.2 m wide, h 0.05 m, steel, 20 elements around):
+midpoint     one ring flying at 10 m/s and spinning at 20 rad/s, no contact, 20 ms at 50 us,
+             rho_inf = 1 (the implicit midpoint rule) with newton_tol 1e-13: the angular
+             momentum is kept to 1e-9 of L0 (conservation: the scheme keeps it exactly, up to
+             Newton's tolerance; the thesis' Newmark drifts 2.8e-4 here, the trapezoidal rule
+             3.5e-7); L0 = m (R^2 + h^2/4) omega to 1e-5.
+order        the same ring with rho_inf = 0.8 at 50 us and 25 us (newton_tol 1e-13): the drift of
+             L at dt/2 is at most 0.35 of the drift at dt (second order: 1/4; the thesis'
+             first-order Newmark gives 1/2).
+adaptive     the two thesis rings with ring 2 moved to x = 2.0137 m: the facing nodes (on the
+             x axis) are 0.0137 m apart, closing at 10 m/s, so contact begins at t = 1.37 ms
+             exactly (both rings fly rigidly until then). rho_inf = 0.8 with tolerance 1e-4
+             (dt = 50 us is the first step and the step at contact): runs to the end; the step
+             before the first contact ends at 1.37 ms to 1e-9 s (the predicted time of
+             contact, not stepped over); every frame lands on its 1 ms time to 1e-12 s; linear
+             momentum kept to 1e-8; no tensile multiplier (lambda_max <= 0) and no active
+             gap beyond the contact tolerance; fewer steps than the 800 of the deck's fixed dt.
+deck         rho_inf given with beta is refused (exit 2, the message names &run, rho_inf and
+             beta); rho_inf = 1.5 and tolerance = -1 are refused naming the field.
+"""
+import os
+import sys
+
+import numpy as np
+
+from casca_testlib import Checks, history, momentum_error, run, run_scene
+
+casca, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:4]]
+os.makedirs(work, exist_ok=True)
+ck = Checks()
+ring = os.path.join(meshdir, "ring_20x1.msh")
+STEEL = "young = 210e9, poisson = 0.3, density = 7700"
+R, H, W, RHO = 1.0, 0.05, 0.2, 7700.0
+MASS = RHO * 2 * np.pi * R * W * H
+
+
+def spin(name, scheme, dt):
+    out, _ = run_scene(casca, ck, work, name, f"""&run dt = {dt}, t_end = 0.02, {scheme}, newton_tol = 1e-13 /
+&output vtu = .false., plots = .false. /
+&body name = 'ring', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0,
+  omega = 0.0, 0.0, 20.0, {STEEL}, thickness = {H} /
+""")
+    if out is None:
+        return None
+    h = history(out)
+    L = np.stack([h["Lx"], h["Ly"], h["Lz"]]).T
+    L0 = MASS * (R**2 + H**2 / 4) * 20.0
+    ck.close("%s: |L0| = m (R^2 + h^2/4) omega" % name, np.linalg.norm(L[0]), L0, 1e-5)
+    return np.max(np.linalg.norm(L - L[0], axis=1)) / L0
+
+
+drift = spin("midpoint", "rho_inf = 1.0", 5e-5)
+if drift is not None:
+    ck.le("midpoint (rho_inf 1): max |L - L0| / |L0| over 20 ms", drift, 1e-9)
+d1 = spin("order", "rho_inf = 0.8", 5e-5)
+d2 = spin("order_dt_half", "rho_inf = 0.8", 2.5e-5)
+if d1 is not None and d2 is not None:
+    ck.le("rho_inf 0.8: drift of L at dt/2 over drift at dt (%.2e, %.2e; second order 0.25)" % (d1, d2),
+          d2 / d1, 0.35)
+
+T_HIT = 0.0137 / 10.0
+out, _ = run_scene(casca, ck, work, "adaptive", f"""&run dt = 5e-5, t_end = 0.04, rho_inf = 0.8, tolerance = 1e-4 /
+&output interval = 1e-3, vtu = .false., plots = .false. /
+&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0, {STEEL}, thickness = {H} /
+&body name = 'ring2', mesh = 'file', file = '{ring}', center = 2.0137, 0.0, 0.0, {STEEL}, thickness = {H} /
+&contact surface = 'mid', pairs = 'ring1', 'ring2' /
+""")
+if out is not None:
+    h = history(out)
+    on = np.nonzero(h["contacts"] > 0)[0]
+    ck.record("adaptive: the rings touch", on.size > 0)
+    if on.size:
+        ck.le("adaptive: |end of the step before the first contact - 1.37 ms| [s]",
+              abs(h["t"][on[0] - 1] - T_HIT), 1e-9)
+    t = h["t"]
+    frames = [np.min(np.abs(t - k * 1e-3)) for k in range(41)]
+    ck.le("adaptive: largest distance of a 1 ms frame time from the nearest step end [s]", max(frames), 1e-12)
+    ck.le("adaptive: linear momentum kept, max |p - p0| / |p0|", momentum_error(h), 1e-8)
+    ck.le("adaptive: most tensile multiplier, lambda_max [N]", np.max(h["lambda_max"]), 0.0)
+    ck.le("adaptive: largest active gap [m] (contact tolerance 1e-7 x scene size 3.2 m)",
+          np.max(h["gap_max"]), 1e-7 * 3.2)
+    ck.le("adaptive: steps (the deck's fixed dt: 800)", len(t) - 1, 799)
+
+
+def refused(name, run_line, words):
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(f"""&run {run_line} /
+&body name = 'ring', mesh = 'file', file = '{ring}', {STEEL}, thickness = {H} /
+""")
+    p = run([casca, "check", deck])
+    ck.record("%s: refused with exit 2" % name, p.returncode == 2, "exit %d" % p.returncode)
+    ck.record("%s: the message names %s" % (name, ", ".join(words)),
+              all(w in p.stderr for w in words), p.stderr.strip()[-300:])
+
+
+refused("deck_both", "dt = 1e-4, t_end = 1e-3, rho_inf = 0.8, beta = 0.3", ["&run", "rho_inf", "beta"])
+refused("deck_rho", "dt = 1e-4, t_end = 1e-3, rho_inf = 1.5", ["&run: rho_inf", "0..1"])
+refused("deck_tol", "dt = 1e-4, t_end = 1e-3, tolerance = -1", ["&run: tolerance"])
+ck.finish()
