@@ -284,7 +284,7 @@ contains
       r%last = progress_t(r%t0, st%t, st%step, 0)
       allocate (r%frozen(model%ndof), r%idle(model%nbody))
       r%frozen = .false.; r%idle = .false.
-      do while (st%t < deck%run%t_end - 1e-9_dp*dt)
+      do while (st%t < deck%run%t_end - 1e-6_dp*dt)
         nm%dt = step_length(r, next_frame)
         if (deck%run%skip_idle_bodies) call update_frozen(r)
         if (allocated(r%err)) then
@@ -329,7 +329,7 @@ contains
         call history_row(r, rep%iters)
         call timer_stop(t_output)
         if (failed(r, 'history')) return
-        if (st%t >= next_frame - 1e-9_dp*dt .or. st%t >= deck%run%t_end - 1e-9_dp*dt) then
+        if (st%t >= next_frame - 1e-6_dp*dt .or. st%t >= deck%run%t_end - 1e-6_dp*dt) then
           call timer_start(t_output)
           call frame(r)
           call timer_stop(t_output)
@@ -337,7 +337,7 @@ contains
           next_frame = next_frame + interval
           if (is_root() .and. .not. r%quiet) call progress(r)
         end if
-        if (st%t >= next_ckpt - 1e-9_dp*dt) then
+        if (st%t >= next_ckpt - 1e-6_dp*dt) then
           call checkpoint(r)
           if (r%code /= exit_ok) return
           next_ckpt = next_ckpt + deck%output%checkpoint_interval

@@ -48,11 +48,16 @@ def deck(scheme, dt):
 """
 
 
-def run(name, scheme, dt):
+def run(name, scheme, dt, keep=False):
+    """run the deck into WORK/NAME; keep: reuse a finished run of the same deck (the
+    references: their wall time is not reported)"""
     path = os.path.join(work, name + ".nml")
-    with open(path, "w") as f:
-        f.write(deck(scheme, dt))
     out = os.path.join(work, name)
+    text = deck(scheme, dt)
+    if keep and os.path.exists(os.path.join(out, "history.dat")) and open(path).read() == text:
+        return history(out), 0.0
+    with open(path, "w") as f:
+        f.write(text)
     t0 = time.time()
     p = subprocess.run([casca, "run", path, "--out", out, "-q"], env=ENV, capture_output=True, text=True)
     wall = time.time() - t0
@@ -65,6 +70,7 @@ def run(name, scheme, dt):
 def frames(h):
     """the rows at the output frames (every 1 ms)"""
     k = np.nonzero(np.abs(h["t"] / 1e-3 - np.round(h["t"] / 1e-3)) < 1e-6)[0]
+    k = k[np.unique(np.round(h["t"][k] / 1e-3), return_index=True)[1]]   # (one row a frame)
     return h["t"][k], np.stack([h["p1_x"][k], h["p1_y"][k], h["p2_x"][k], h["p2_y"][k]]).T
 
 
@@ -77,8 +83,8 @@ def error(h, ref):
                np.max(np.hypot(x[:, 2] - xr[:, 2], x[:, 3] - xr[:, 3])))
 
 
-ref, _ = run("ref", "rho_inf = 0.8, newton_tol = 1e-11", 3.125e-6)
-ref2, _ = run("ref2", "rho_inf = 0.8, newton_tol = 1e-11", 6.25e-6)
+ref, _ = run("ref", "rho_inf = 0.8, newton_tol = 1e-11", 3.125e-6, keep=True)
+ref2, _ = run("ref2", "rho_inf = 0.8, newton_tol = 1e-11", 6.25e-6, keep=True)
 print("reference: generalized-alpha 0.8 at 3.125 us; its distance to 6.25 us: %.3e m "
       "(its own error about a third of that)" % error(ref2, ref), flush=True)
 series = {
