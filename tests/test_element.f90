@@ -6,6 +6,7 @@ program test_element
   use casca_shape_tri10, only: tri10_shape, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, &
                                  shell_energy_force, shell_mass, svk_lame, shell_stress, von_mises
+  use casca_vectors, only: cross
   use casca_check, only: check_le, check_close, check_true, check_summary
   implicit none
 
@@ -136,21 +137,16 @@ contains
 
   subroutine stress_of_homogeneous_deformation()
     real(dp) :: mm(3, 3), ee(3, 3), ss(3, 3), sig_ref(3, 3), sig(3, 3), xi(3), worst, dm
+    real(dp), parameter :: eye(3, 3) = reshape([1._dp, 0._dp, 0._dp, 0._dp, 1._dp, 0._dp, 0._dp, 0._dp, &
+                                                1._dp], [3, 3])
     real(dp), parameter :: pts(2, 3) = reshape([0.2_dp, 0.1_dp, 0.5_dp, 0.3_dp, 1._dp/3, 1._dp/3], [2, 3])
     integer :: ii, ll
     mm = reshape([1.02_dp, 0.01_dp, -0.03_dp, 0.04_dp, 0.97_dp, 0.02_dp, -0.01_dp, 0.05_dp, 1.03_dp], &
                  [3, 3])
     call svk_lame(1._dp, 0.3_dp, lam, mu)
-    ee = 0.5_dp*matmul(transpose(mm), mm)
-    do ii = 1, 3
-      ee(ii, ii) = ee(ii, ii) - 0.5_dp
-    end do
-    ss = 2*mu*ee
-    do ii = 1, 3
-      ss(ii, ii) = ss(ii, ii) + lam*(ee(1, 1) + ee(2, 2) + ee(3, 3))
-    end do
-    dm = mm(1, 1)*(mm(2, 2)*mm(3, 3) - mm(3, 2)*mm(2, 3)) - mm(1, 2)*(mm(2, 1)*mm(3, 3) &
-         - mm(3, 1)*mm(2, 3)) + mm(1, 3)*(mm(2, 1)*mm(3, 2) - mm(3, 1)*mm(2, 2))
+    ee = 0.5_dp*(matmul(transpose(mm), mm) - eye)
+    ss = lam*(ee(1, 1) + ee(2, 2) + ee(3, 3))*eye + 2*mu*ee
+    dm = dot_product(mm(:, 1), cross(mm(:, 2), mm(:, 3)))
     sig_ref = matmul(mm, matmul(ss, transpose(mm)))/dm
     do ll = 1, 10
       q(1:3, ll) = matmul(mm, x0(:, ll))
