@@ -356,7 +356,9 @@ contains
   !> The stress fields of a frame. Per cell, at the centroid: von_mises (mid-surface),
   !> von_mises_top, von_mises_bottom and the Cauchy stress tensors stress_top, stress_mid,
   !> stress_bottom (global axes, 9 components row by row, which ParaView shows as a tensor).
-  !> Per point: the same tensors at the node, averaged over the elements around it.
+  !> Per point: the same tensors at the node, averaged over the elements around it. The
+  !> tensors are written as Float32: they are most of a frame's bytes, and viewing needs no
+  !> more than 7 digits.
   subroutine stress_fields(model, q, cells, points)
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
@@ -399,8 +401,8 @@ contains
         cells = [cells, field('von_mises_'//trim(surface(k)), vm)]
       end if
     end do
-    cells = [cells, (field('stress_'//trim(surface(k)), cell(:, :, k)), k=1, 3)]
-    points = [(field('stress_'//trim(surface(k)), node(:, :, k)), k=1, 3)]
+    cells = [cells, (field('stress_'//trim(surface(k)), cell(:, :, k), single=.true.), k=1, 3)]
+    points = [(field('stress_'//trim(surface(k)), node(:, :, k), single=.true.), k=1, 3)]
   end subroutine stress_fields
 
   !> Close the files (every close checked: a full disk shows here last) and free the folder.
