@@ -355,7 +355,8 @@ contains
 
   !> The stress fields of a frame. Per cell, at the centroid: von_mises (mid-surface),
   !> von_mises_top, von_mises_bottom and the Cauchy stress tensors stress_top, stress_mid,
-  !> stress_bottom (global axes, 9 components row by row, which ParaView shows as a tensor).
+  !> stress_bottom (global axes, 6 components xx yy zz xy yz xz: ParaView's symmetric tensor,
+  !> whose components it names so).
   !> Per point: the same tensors at the node, averaged over the elements around it. The
   !> tensors are written as Float32: they are most of a frame's bytes, and viewing needs no
   !> more than 7 digits.
@@ -366,11 +367,11 @@ contains
     !> xi3 of the surfaces: top is the side the initial fibre points to
     real(dp), parameter :: xi3(3) = [1._dp, 0._dp, -1._dp]
     character(len=*), parameter :: surface(3) = [character(len=6) :: 'top', 'mid', 'bottom']
-    real(dp), allocatable :: cell(:, :, :), node(:, :, :), vm(:, :), share(:)
+    real(dp), allocatable :: cell(:, :, :), node(:, :, :), vm(:, :, :), share(:)
     real(dp) :: sig(3, 3), qe(7, 10), x0(3, 10), v0(3, 10), h, lam, mu
     integer :: e, b, k, l, nodes(10)
 
-    allocate (cell(9, model%nelem, 3), vm(1, model%nelem), node(9, model%nnode, 3), &
+    allocate (cell(6, model%nelem, 3), vm(1, model%nelem, 3), node(6, model%nnode, 3), &
               share(model%nnode))
     node = 0; share = 0
     do e = 1, model%nelem
@@ -381,29 +382,30 @@ contains
       qe = reshape(q(element_dofs(model, e)), [7, 10])
       do k = 1, 3
         sig = shell_stress(x0, v0, h, lam, mu, qe, 1._dp/3, 1._dp/3, xi3(k))
-        cell(:, e, k) = reshape(sig, [9])   ! symmetric: column by column is row by row
+        cell(:, e, k) = symmetric_components(sig)
+        vm(1, e, k) = von_mises(sig)
         do l = 1, 10
           sig = shell_stress(x0, v0, h, lam, mu, qe, tri10_node_xi(1, l), tri10_node_xi(2, l), xi3(k))
-          node(:, nodes(l), k) = node(:, nodes(l), k) + reshape(sig, [9])
+          node(:, nodes(l), k) = node(:, nodes(l), k) + symmetric_components(sig)
         end do
       end do
       share(nodes) = share(nodes) + 1
     end do
     do k = 1, 3
-      node(:, :, k) = node(:, :, k)/spread(max(share, 1._dp), 1, 9)
+      node(:, :, k) = node(:, :, k)/spread(max(share, 1._dp), 1, 6)
     end do
-    allocate (cells(0), points(0))
-    do k = 1, 3
-      vm(1, :) = [(von_mises(reshape(cell(:, e, k), [3, 3])), e=1, model%nelem)]
-      if (k == 2) then
-        cells = [cells, field('von_mises', vm)]
-      else
-        cells = [cells, field('von_mises_'//trim(surface(k)), vm)]
-      end if
-    end do
-    cells = [cells, (field('stress_'//trim(surface(k)), cell(:, :, k), single=.true.), k=1, 3)]
+    cells = [field('von_mises', vm(:, :, 2)), field('von_mises_top', vm(:, :, 1)), &
+             field('von_mises_bottom', vm(:, :, 3)), &
+             (field('stress_'//trim(surface(k)), cell(:, :, k), single=.true.), k=1, 3)]
     points = [(field('stress_'//trim(surface(k)), node(:, :, k), single=.true.), k=1, 3)]
   end subroutine stress_fields
+
+  !> The 6 components of a symmetric tensor in ParaView's order: xx, yy, zz, xy, yz, xz.
+  pure function symmetric_components(t) result(c)
+    real(dp), intent(in) :: t(3, 3)
+    real(dp) :: c(6)
+    c = [t(1, 1), t(2, 2), t(3, 3), t(1, 2), t(2, 3), t(1, 3)]
+  end function symmetric_components
 
   !> Close the files (every close checked: a full disk shows here last) and free the folder.
   subroutine output_close(out, err)
