@@ -5,6 +5,7 @@
 !>   tracked.txt                  a label per tracked node (for the plots)
 module casca_output
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof, element_dofs
@@ -17,7 +18,8 @@ module casca_output
                            h5_table_close
   use casca_mpi, only: is_root
   use casca_strings, only: itoa
-  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line, file_kind, kind_missing
+  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line, file_kind, kind_missing, &
+                         kind_regular
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder
@@ -136,6 +138,9 @@ contains
       if (allocated(err)) return
       out%hist_open = .true.
       call cf_write(out%hist, '#'//join(cols, ' ', '')//new_line('a'), err)
+      ! the header on disk now: a frame that fills the disk before the first flush would
+      ! otherwise leave history.dat without it
+      if (.not. allocated(err)) call cf_flush(out%hist, err)
       if (allocated(err)) return
       call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     else
@@ -413,7 +418,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     if (.not. is_root()) return
     if (out%hist_open) call cf_close(out%hist, err)
-    if (allocated(err)) call cut_to_last_line(out%dir//'/history.dat')
+    if (allocated(err)) call whole_lines(out%dir//'/history.dat')
     out%hist_open = .false.
     if (.not. allocated(err)) call h5_table_flush(out%h5, err)
     if (.not. allocated(err)) call h5_table_close(out%h5, err)
@@ -428,11 +433,22 @@ contains
     if (.not. is_root()) return
     if (out%hist_open) then
       call cf_close(out%hist, e)
-      call cut_to_last_line(out%dir//'/history.dat')
+      call whole_lines(out%dir//'/history.dat')
     end if
     out%hist_open = .false.
     call h5_table_close(out%h5, e)
     if (out%locked) call unlock_folder(out%dir)
     out%locked = .false.
   end subroutine output_release
+
+  !> After a failed write: the history file cut to its last whole line, or gone if it has
+  !> none (complete under its name or not there).
+  subroutine whole_lines(path)
+    character(len=*), intent(in) :: path
+    integer(int64) :: bytes
+    call cut_to_last_line(path)
+    if (file_kind(path, bytes) == kind_regular) then
+      if (bytes == 0) call delete_file(path)
+    end if
+  end subroutine whole_lines
 end module casca_output
