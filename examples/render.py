@@ -3,27 +3,76 @@ speed (the thesis' Figs. 8 and 14). Run with ParaView's batch interpreter:
 
     xvfb-run -a pvbatch render.py out/two_rings 0.0 0.01 0.02 0.03
 
-writes out/two_rings/frame_t<time>.png for each time (the nearest frame)."""
+writes out/two_rings/frame_t<time>.png for each time (the nearest frame's time, 6 digits). Every picture has
+the same camera and colour range, so that they compare: the camera looks along the thinnest
+side of the box holding all bodies in all the chosen frames (down the axis of the rings),
+with the box's longest side across the picture, and shows the whole box; the colours run
+from 0 to the highest speed in those frames."""
+import math
 import os
 import sys
 
 from paraview.simple import (Calculator, ColorBy, GetActiveViewOrCreate, GetColorTransferFunction,
-                             GetScalarBar, PVDReader, Render, ResetCamera, SaveScreenshot, Show, Text,
+                             GetScalarBar, PVDReader, Render, SaveScreenshot, Show, Text,
                              UpdatePipeline)
+
+WIDTH, HEIGHT = 1200, 700
+MARGIN = 1.3   # room around the bodies (and for the colour bar), as a factor on the box
+
+
+def nearest_frames(reader, times):
+    """The frame time nearest to each time asked for."""
+    available = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
+    return [min(available, key=lambda a: abs(a - t)) for t in times]
+
+
+def bounds_and_top_speed(speed, frames):
+    """The box (xmin, xmax, ymin, ymax, zmin, zmax) holding the bodies in all frames, and the
+    highest speed in them."""
+    box = [math.inf, -math.inf] * 3
+    top = 0.0
+    for tt in frames:
+        UpdatePipeline(tt, speed)
+        b = speed.GetDataInformation().GetBounds()
+        box = [min(box[i], b[i]) if i % 2 == 0 else max(box[i], b[i]) for i in range(6)]
+        top = max(top, speed.PointData["speed"].GetRange()[1])
+    return box, top
+
+
+def place_camera(view, box):
+    """Look along the box's thinnest side at its centre, its longest side across the picture
+    pointing right, from the distance at which the whole box fits the view angle."""
+    centre = [0.5 * (box[2 * i] + box[2 * i + 1]) for i in range(3)]
+    size = [box[2 * i + 1] - box[2 * i] for i in range(3)]
+    thin, up, across = sorted(range(3), key=lambda i: size[i])
+    half = 0.5 * MARGIN * max(size[up], size[across] * HEIGHT / WIDTH, 1e-12)
+    distance = half / math.tan(math.radians(0.5 * view.CameraViewAngle)) + 0.5 * size[thin]
+    # from +thin, looking along -thin with `up` up, the right-hand side is (-thin) x up:
+    # +across when (thin, up, across) is not a cyclic order of (x, y, z); else look from -thin
+    side = 1.0 if (up - thin) % 3 == 2 else -1.0
+    position = list(centre)
+    position[thin] += side * distance
+    view.CameraFocalPoint = centre
+    view.CameraPosition = position
+    view.CameraViewUp = [1.0 if i == up else 0.0 for i in range(3)]
+
 
 folder = sys.argv[1]
 times = [float(t) for t in sys.argv[2:]] or [0.0]
 reader = PVDReader(FileName=os.path.join(folder, "run.pvd"))
 speed = Calculator(Input=reader, ResultArrayName="speed", Function="mag(velocity)")
 view = GetActiveViewOrCreate("RenderView")
-view.ViewSize = [1200, 700]
+view.ViewSize = [WIDTH, HEIGHT]
 view.UseColorPaletteForBackground = 0
 view.Background = [1, 1, 1]
 view.OrientationAxesVisibility = 1
 display = Show(speed, view)
 ColorBy(display, ("POINTS", "speed"))
+# mostly ambient light: a face seen edge-on keeps a colour that reads on the bar
+display.Ambient, display.Diffuse = 0.7, 0.3
 lut = GetColorTransferFunction("speed")
 lut.ApplyPreset("Viridis (matplotlib)", True)
+lut.AutomaticRescaleRangeMode = "Never"   # keep the range below in every picture
 display.SetScalarBarVisibility(view, True)
 bar = GetScalarBar(lut, view)
 bar.Title = "speed [m/s]"
@@ -33,18 +82,17 @@ bar.LabelColor = [0, 0, 0]
 label = Text()
 label_display = Show(label, view)
 label_display.Color = [0, 0, 0]
-available = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
-view.CameraPosition = [1.0, 0.0, 8.0]
-view.CameraFocalPoint = [1.0, 0.0, 0.0]
-view.CameraViewUp = [0.0, 1.0, 0.0]
-for t in times:
-    tt = min(available, key=lambda a: abs(a - t))
+
+frames = nearest_frames(reader, times)
+box, top = bounds_and_top_speed(speed, frames)
+Render(view)   # the view's first render resets the camera: place it after that one
+place_camera(view, box)
+lut.RescaleTransferFunction(0.0, top if top > 0 else 1.0)
+for tt in frames:
     view.ViewTime = tt
     UpdatePipeline(tt, speed)
-    lut.RescaleTransferFunction(0.0, 12.0)
     label.Text = "t = %.2f ms   (colour: speed [m/s])" % (1e3 * tt)
-    ResetCamera(view)
     Render(view)
-    out = os.path.join(folder, "frame_t%.4f.png" % tt)
-    SaveScreenshot(out, view, ImageResolution=[1200, 700])
+    out = os.path.join(folder, "frame_t%.6g.png" % tt)
+    SaveScreenshot(out, view, ImageResolution=[WIDTH, HEIGHT])
     print(out)

@@ -5,7 +5,8 @@ program test_element
   use casca_error, only: error_t
   use casca_shape_tri10, only: tri10_shape, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, &
-                                 shell_energy_force, shell_mass, svk_lame
+                                 shell_energy_force, shell_mass, svk_lame, shell_stress, von_mises
+  use casca_vectors, only: cross
   use casca_check, only: check_le, check_close, check_true, check_summary
   implicit none
 
@@ -120,9 +121,47 @@ program test_element
   call check_close('mass: total translational mass = rho h area', sum(m(1:10, 1:10)), &
                    7700._dp*h*area, 1e-6_dp)
 
+  ! stress: y = M X (Y = M x0, G = M v0, A = 0) makes F = M at every point of the curved
+  ! element, top to bottom, so sigma = M S M^T / det M with S the SVK stress of (M^T M - I)/2
+  call stress_of_homogeneous_deformation()
+  call check_close('von Mises of uniaxial stress diag(-3, 0, 0) = 3', &
+                   von_mises(reshape([-3._dp, 0._dp, 0._dp, 0._dp, 0._dp, 0._dp, 0._dp, 0._dp, &
+                                      0._dp], [3, 3])), 3._dp, 1e-14_dp)
+  call check_close('von Mises of pure shear tau = 2: sqrt(3) tau', &
+                   von_mises(reshape([0._dp, 2._dp, 0._dp, 2._dp, 0._dp, 0._dp, 0._dp, 0._dp, &
+                                      0._dp], [3, 3])), 2*sqrt(3._dp), 1e-14_dp)
+
   call check_summary()
 
 contains
+
+  subroutine stress_of_homogeneous_deformation()
+    real(dp) :: mm(3, 3), ee(3, 3), ss(3, 3), sig_ref(3, 3), sig(3, 3), xi(3), worst, dm
+    real(dp), parameter :: eye(3, 3) = reshape([1._dp, 0._dp, 0._dp, 0._dp, 1._dp, 0._dp, 0._dp, 0._dp, &
+                                                1._dp], [3, 3])
+    real(dp), parameter :: pts(2, 3) = reshape([0.2_dp, 0.1_dp, 0.5_dp, 0.3_dp, 1._dp/3, 1._dp/3], [2, 3])
+    integer :: ii, ll
+    mm = reshape([1.02_dp, 0.01_dp, -0.03_dp, 0.04_dp, 0.97_dp, 0.02_dp, -0.01_dp, 0.05_dp, 1.03_dp], &
+                 [3, 3])
+    call svk_lame(1._dp, 0.3_dp, lam, mu)
+    ee = 0.5_dp*(matmul(transpose(mm), mm) - eye)
+    ss = lam*(ee(1, 1) + ee(2, 2) + ee(3, 3))*eye + 2*mu*ee
+    dm = dot_product(mm(:, 1), cross(mm(:, 2), mm(:, 3)))
+    sig_ref = matmul(mm, matmul(ss, transpose(mm)))/dm
+    do ll = 1, 10
+      q(1:3, ll) = matmul(mm, x0(:, ll))
+      q(4:6, ll) = matmul(mm, v0(:, ll))
+    end do
+    q(7, :) = 0
+    worst = 0
+    do ii = 1, 9   ! three area points, each on the bottom, mid and top surfaces
+      xi = [pts(:, 1 + (ii - 1)/3), real(mod(ii - 1, 3) - 1, dp)]
+      sig = shell_stress(x0, v0, h, lam, mu, q, xi(1), xi(2), xi(3))
+      worst = max(worst, maxval(abs(sig - sig_ref))/maxval(abs(sig_ref)))
+    end do
+    call check_le('stress of y = M X at 3 points x (bottom, mid, top) = M S M^T / det M (rel)', &
+                  worst, 1e-12_dp)
+  end subroutine stress_of_homogeneous_deformation
 
   character(len=8) function rname(ic)
     integer, intent(in) :: ic

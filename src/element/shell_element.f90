@@ -17,7 +17,7 @@ module casca_shell_element
   implicit none
   private
   public :: shell_rule_t, shell_rule_init, shell_reference, shell_energy_force, shell_mass
-  public :: ndof_node, ndof_elem, svk_lame, shell_von_mises
+  public :: ndof_node, ndof_elem, svk_lame, shell_stress, von_mises
 
   integer, parameter :: ndof_node = 7
   integer, parameter :: ndof_elem = 70
@@ -272,24 +272,22 @@ contains
     end function vidx
   end subroutine shell_energy_force
 
-  !> Von Mises stress of the Cauchy stress at (xi1, xi2) on the mid-surface (xi3 = 0), for
-  !> output: sigma = F S F^T / det F with F = A1 A0^-1.
-  pure real(dp) function shell_von_mises(x0, v0, h, lam, mu, q, xi1, xi2) result(vm)
-    real(dp), intent(in) :: x0(3, 10), v0(3, 10), h, lam, mu, q(7, 10), xi1, xi2
-    real(dp) :: phi(10), dphi(10, 2), a0(3, 3), a1(3, 3), f(3, 3), e(3, 3), s(3, 3), sig(3, 3)
-    real(dp) :: inv(3, 3), d, g(3)
+  !> Cauchy stress (global axes) at (xi1, xi2, xi3) of the element, for output:
+  !> sigma = F S F^T / det F with F = A1 A0^-1 and S the SVK stress of the Green strain.
+  !> xi3 = -1 is the bottom face, 0 the mid-surface, +1 the top face: the side the initial
+  !> fibre V points to.
+  pure function shell_stress(x0, v0, h, lam, mu, q, xi1, xi2, xi3) result(sig)
+    real(dp), intent(in) :: x0(3, 10), v0(3, 10), h, lam, mu, q(7, 10), xi1, xi2, xi3
+    real(dp) :: sig(3, 3)
+    real(dp) :: phi(10), dphi(10, 2), a0(3, 3), f(3, 3), e(3, 3), s(3, 3), inv(3, 3), d
     integer :: i
     call tri10_shape(xi1, xi2, phi, dphi)
-    a0 = initial_jacobian(phi, dphi, x0, v0, h, 0._dp)
-    g = matmul(q(4:6, :), phi)
-    a1(:, 1) = matmul(q(1:3, :), dphi(:, 1))
-    a1(:, 2) = matmul(q(1:3, :), dphi(:, 2))
-    a1(:, 3) = 0.5_dp*h*g          ! at xi3 = 0 the thickness parameter only enters d/dxi3
+    a0 = initial_jacobian(phi, dphi, x0, v0, h, xi3)
     d = det3(a0)
     inv(:, 1) = cross(a0(:, 2), a0(:, 3))/d   ! rows of A0^-1, stored as columns
     inv(:, 2) = cross(a0(:, 3), a0(:, 1))/d
     inv(:, 3) = cross(a0(:, 1), a0(:, 2))/d
-    f = matmul(a1, transpose(inv))
+    f = matmul(current_jacobian(phi, dphi, q, h, xi3), transpose(inv))
     e = 0.5_dp*matmul(transpose(f), f)
     do i = 1, 3
       e(i, i) = e(i, i) - 0.5_dp
@@ -299,10 +297,34 @@ contains
       s(i, i) = s(i, i) + lam*(e(1, 1) + e(2, 2) + e(3, 3))
     end do
     sig = matmul(f, matmul(s, transpose(f)))/det3(f)
+  end function shell_stress
+
+  !> A1 = dy/dxi at a point of the current configuration (the map of the module header):
+  !> dy/dxi_j = Y,j + s G,j + s_j G and dy/dxi3 = (h/2 + a h z) G, s = h/2 (z + a z^2),
+  !> s_j = h/2 z^2 a,j; the same terms the energy kernel forms inline per thickness point.
+  pure function current_jacobian(phi, dphi, q, h, z) result(a1)
+    real(dp), intent(in) :: phi(10), dphi(10, 2), q(7, 10), h, z
+    real(dp) :: a1(3, 3)
+    real(dp) :: g(3), a, hz2, s
+    integer :: j
+    g = matmul(q(4:6, :), phi)
+    a = dot_product(q(7, :), phi)
+    hz2 = 0.5_dp*h*z*z
+    s = 0.5_dp*h*z + a*hz2
+    do j = 1, 2
+      a1(:, j) = matmul(q(1:3, :), dphi(:, j)) + s*matmul(q(4:6, :), dphi(:, j)) &
+                 + (hz2*dot_product(q(7, :), dphi(:, j)))*g
+    end do
+    a1(:, 3) = (0.5_dp*h + a*h*z)*g
+  end function current_jacobian
+
+  !> Von Mises equivalent stress of a stress tensor.
+  pure real(dp) function von_mises(sig) result(vm)
+    real(dp), intent(in) :: sig(3, 3)
     vm = sqrt(0.5_dp*((sig(1, 1) - sig(2, 2))**2 + (sig(2, 2) - sig(3, 3))**2 &
                       + (sig(3, 3) - sig(1, 1))**2) &
               + 3*(sig(1, 2)**2 + sig(2, 3)**2 + sig(1, 3)**2))
-  end function shell_von_mises
+  end function von_mises
 
 
   !> Constant consistent mass of one element from the part of the map linear in (Y, G):

@@ -5,18 +5,21 @@
 !>   tracked.txt                  a label per tracked node (for the plots)
 module casca_output
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof, element_dofs
   use casca_newmark, only: state_t
   use casca_accounting, only: balance_t
-  use casca_shell_element, only: shell_von_mises
+  use casca_shell_element, only: shell_stress, von_mises
+  use casca_shape_tri10, only: tri10_node_xi
   use casca_vtu_writer, only: field_t, field, write_vtu, write_pvd
   use casca_hdf5_io, only: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, &
                            h5_table_close
   use casca_mpi, only: is_root
   use casca_strings, only: itoa
-  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line, file_kind, kind_missing
+  use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line, file_kind, kind_missing, &
+                         kind_regular
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder
@@ -135,6 +138,9 @@ contains
       if (allocated(err)) return
       out%hist_open = .true.
       call cf_write(out%hist, '#'//join(cols, ' ', '')//new_line('a'), err)
+      ! the header on disk now: a frame that fills the disk before the first flush would
+      ! otherwise leave history.dat without it
+      if (.not. allocated(err)) call cf_flush(out%hist, err)
       if (allocated(err)) return
       call h5_table_create(out%h5, out%dir//'/history.h5', cols, err, in_memory=.true.)
     else
@@ -319,16 +325,17 @@ contains
     type(state_t), intent(in) :: st
     type(field_t), intent(in) :: extra(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), allocatable :: x(:, :), u(:, :), v(:, :), g(:, :), a(:, :), body(:, :), vm(:, :)
+    real(dp), allocatable :: x(:, :), u(:, :), v(:, :), g(:, :), a(:, :), body(:, :)
+    type(field_t), allocatable :: cell_stress(:), point_stress(:)
     character(len=32) :: name
-    integer :: n, e, b
+    integer :: n
     if (.not. is_root()) return
     if (.not. (all(ieee_is_finite(st%q)) .and. all(ieee_is_finite(st%qd)))) then
       call fatal_error(err, 'the state at step '//itoa(st%step)//' is not finite; no frame written')
       return
     end if
     allocate (x(3, model%nnode), u(3, model%nnode), v(3, model%nnode), g(3, model%nnode), &
-              a(1, model%nnode), body(1, model%nelem), vm(1, model%nelem))
+              a(1, model%nnode))
     do n = 1, model%nnode
       x(:, n) = st%q(dof(n, 1):dof(n, 3))
       u(:, n) = x(:, n) - model%x0(:, n)
@@ -336,19 +343,14 @@ contains
       g(:, n) = st%q(dof(n, 4):dof(n, 6))
       a(1, n) = st%q(dof(n, 7))
     end do
-    do e = 1, model%nelem
-      b = model%elem_body(e)
-      body(1, e) = b
-      vm(1, e) = shell_von_mises(model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
-                                 model%body(b)%thickness, model%body(b)%lam, model%body(b)%mu, &
-                                 reshape(st%q(element_dofs(model, e)), [7, 10]), 1._dp/3, 1._dp/3)
-    end do
+    body = reshape(real(model%elem_body, dp), [1, model%nelem])
+    call stress_fields(model, st%q, cell_stress, point_stress)
     write (name, '(a,i5.5,a)') 'frame_', out%nframes, '.vtu'
     ! geometry in the current configuration: ParaView shows the deformed shells directly
     call write_vtu(out%dir//'/'//trim(name), x, model%conn, &
                    [field('displacement', u), field('velocity', v), field('fibre', g), &
-                    field('thickness_param', a), extra], &
-                   [field('body', body), field('von_mises', vm)], err)
+                    field('thickness_param', a), extra, point_stress], &
+                   [field('body', body), cell_stress], err)
     if (allocated(err)) return
     out%nframes = out%nframes + 1
     out%files = [character(len=32) :: out%files, name]
@@ -356,13 +358,67 @@ contains
     call write_pvd(out%dir//'/run.pvd', out%files, out%times, err)
   end subroutine output_frame
 
+  !> The stress fields of a frame. Per cell, at the centroid: von_mises (mid-surface),
+  !> von_mises_top, von_mises_bottom and the Cauchy stress tensors stress_top, stress_mid,
+  !> stress_bottom (global axes, 6 components xx yy zz xy yz xz: ParaView's symmetric tensor,
+  !> whose components it names so).
+  !> Per point: the same tensors at the node, averaged over the elements around it. The
+  !> tensors are written as Float32: they are most of a frame's bytes, and viewing needs no
+  !> more than 7 digits.
+  subroutine stress_fields(model, q, cells, points)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    type(field_t), allocatable, intent(out) :: cells(:), points(:)
+    !> xi3 of the surfaces: top is the side the initial fibre points to
+    real(dp), parameter :: xi3(3) = [1._dp, 0._dp, -1._dp]
+    character(len=*), parameter :: surface(3) = [character(len=6) :: 'top', 'mid', 'bottom']
+    real(dp), allocatable :: cell(:, :, :), node(:, :, :), vm(:, :, :), share(:)
+    real(dp) :: sig(3, 3), qe(7, 10), x0(3, 10), v0(3, 10), h, lam, mu
+    integer :: e, b, k, l, nodes(10)
+
+    allocate (cell(6, model%nelem, 3), vm(1, model%nelem, 3), node(6, model%nnode, 3), &
+              share(model%nnode))
+    node = 0; share = 0
+    do e = 1, model%nelem
+      b = model%elem_body(e); h = model%body(b)%thickness
+      lam = model%body(b)%lam; mu = model%body(b)%mu
+      nodes = model%conn(:, e)
+      x0 = model%x0(:, nodes); v0 = model%v0(:, nodes)
+      qe = reshape(q(element_dofs(model, e)), [7, 10])
+      do k = 1, 3
+        sig = shell_stress(x0, v0, h, lam, mu, qe, 1._dp/3, 1._dp/3, xi3(k))
+        cell(:, e, k) = symmetric_components(sig)
+        vm(1, e, k) = von_mises(sig)
+        do l = 1, 10
+          sig = shell_stress(x0, v0, h, lam, mu, qe, tri10_node_xi(1, l), tri10_node_xi(2, l), xi3(k))
+          node(:, nodes(l), k) = node(:, nodes(l), k) + symmetric_components(sig)
+        end do
+      end do
+      share(nodes) = share(nodes) + 1
+    end do
+    do k = 1, 3
+      node(:, :, k) = node(:, :, k)/spread(max(share, 1._dp), 1, 6)
+    end do
+    cells = [field('von_mises', vm(:, :, 2)), field('von_mises_top', vm(:, :, 1)), &
+             field('von_mises_bottom', vm(:, :, 3)), &
+             (field('stress_'//trim(surface(k)), cell(:, :, k), single=.true.), k=1, 3)]
+    points = [(field('stress_'//trim(surface(k)), node(:, :, k), single=.true.), k=1, 3)]
+  end subroutine stress_fields
+
+  !> The 6 components of a symmetric tensor in ParaView's order: xx, yy, zz, xy, yz, xz.
+  pure function symmetric_components(t) result(c)
+    real(dp), intent(in) :: t(3, 3)
+    real(dp) :: c(6)
+    c = [t(1, 1), t(2, 2), t(3, 3), t(1, 2), t(2, 3), t(1, 3)]
+  end function symmetric_components
+
   !> Close the files (every close checked: a full disk shows here last) and free the folder.
   subroutine output_close(out, err)
     type(output_t), intent(inout) :: out
     type(error_t), allocatable, intent(out) :: err
     if (.not. is_root()) return
     if (out%hist_open) call cf_close(out%hist, err)
-    if (allocated(err)) call cut_to_last_line(out%dir//'/history.dat')
+    if (allocated(err)) call whole_lines(out%dir//'/history.dat')
     out%hist_open = .false.
     if (.not. allocated(err)) call h5_table_flush(out%h5, err)
     if (.not. allocated(err)) call h5_table_close(out%h5, err)
@@ -377,11 +433,22 @@ contains
     if (.not. is_root()) return
     if (out%hist_open) then
       call cf_close(out%hist, e)
-      call cut_to_last_line(out%dir//'/history.dat')
+      call whole_lines(out%dir//'/history.dat')
     end if
     out%hist_open = .false.
     call h5_table_close(out%h5, e)
     if (out%locked) call unlock_folder(out%dir)
     out%locked = .false.
   end subroutine output_release
+
+  !> After a failed write: the history file cut to its last whole line, or gone if it has
+  !> none (complete under its name or not there).
+  subroutine whole_lines(path)
+    character(len=*), intent(in) :: path
+    integer(int64) :: bytes
+    call cut_to_last_line(path)
+    if (file_kind(path, bytes) == kind_regular) then
+      if (bytes == 0) call delete_file(path)
+    end if
+  end subroutine whole_lines
 end module casca_output

@@ -12,7 +12,7 @@
 !> one file system replaces the target atomically.
 module casca_vtu_writer
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
-  use, intrinsic :: iso_fortran_env, only: int8, int32, int64
+  use, intrinsic :: iso_fortran_env, only: int8, int32, int64, real32
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_files, only: rename_file, close_complete, delete_file
@@ -25,6 +25,7 @@ module casca_vtu_writer
   type :: field_t
     character(len=:), allocatable :: name
     real(dp), allocatable :: v(:, :)
+    logical :: single = .false.   !< written as Float32: half the bytes, 7 significant digits
   end type field_t
 
   integer, parameter :: vtk_lagrange_triangle = 69
@@ -36,13 +37,16 @@ module casca_vtu_writer
 
 contains
 
-  !> Build a field_t (so callers can write field('thickness', reshape(t, [1, n]))).
-  pure function field(name, v) result(f)
+  !> Build a field_t (so callers can write field('thickness', reshape(t, [1, n]))); single:
+  !> write it as Float32 (for large derived fields viewed, not read back exactly).
+  pure function field(name, v, single) result(f)
     character(len=*), intent(in) :: name
     real(dp), intent(in) :: v(:, :)
+    logical, intent(in), optional :: single
     type(field_t) :: f
     f%name = name
     allocate (f%v, source=v)   ! (plain f%v = v trips a spurious gfortran 12 warning)
+    if (present(single)) f%single = single
   end function field
 
   !> Write one UnstructuredGrid of cubic triangles to path (.vtu).
@@ -98,16 +102,14 @@ contains
     if (size(point_fields) > 0) then
       xml = xml//'      <PointData>'//nl
       do i = 1, size(point_fields)
-        xml = xml//data_array('Float64', point_fields(i)%name, size(point_fields(i)%v, 1), &
-                              offset, 8_int64*size(point_fields(i)%v, kind=int64))
+        xml = xml//field_array(point_fields(i), offset)
       end do
       xml = xml//'      </PointData>'//nl
     end if
     if (size(cell_fields) > 0) then
       xml = xml//'      <CellData>'//nl
       do i = 1, size(cell_fields)
-        xml = xml//data_array('Float64', cell_fields(i)%name, size(cell_fields(i)%v, 1), &
-                              offset, 8_int64*size(cell_fields(i)%v, kind=int64))
+        xml = xml//field_array(cell_fields(i), offset)
       end do
       xml = xml//'      </CellData>'//nl
     end if
@@ -139,12 +141,10 @@ contains
     ! be followed directly by a newline.
     write (u, iostat=ios, iomsg=msg) xml
     do i = 1, size(point_fields)
-      if (ios == 0) write (u, iostat=ios, iomsg=msg) &
-        nbytes(8, size(point_fields(i)%v, kind=int64)), point_fields(i)%v
+      if (ios == 0) call write_field(u, point_fields(i), ios, msg)
     end do
     do i = 1, size(cell_fields)
-      if (ios == 0) write (u, iostat=ios, iomsg=msg) &
-        nbytes(8, size(cell_fields(i)%v, kind=int64)), cell_fields(i)%v
+      if (ios == 0) call write_field(u, cell_fields(i), ios, msg)
     end do
     if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, size(x, kind=int64)), x
     if (ios == 0) write (u, iostat=ios, iomsg=msg) &
@@ -250,6 +250,31 @@ contains
       end if
     end do
   end subroutine check_fields
+
+  !> The <DataArray .../> line of a field at offset (Float32 or Float64); advances offset.
+  function field_array(f, offset) result(s)
+    type(field_t), intent(in) :: f
+    integer(int64), intent(inout) :: offset
+    character(len=:), allocatable :: s
+    if (f%single) then
+      s = data_array('Float32', f%name, size(f%v, 1), offset, 4_int64*size(f%v, kind=int64))
+    else
+      s = data_array('Float64', f%name, size(f%v, 1), offset, 8_int64*size(f%v, kind=int64))
+    end if
+  end function field_array
+
+  !> A field's appended block: its byte count, then its values as declared by field_array.
+  subroutine write_field(u, f, ios, msg)
+    integer, intent(in) :: u
+    type(field_t), intent(in) :: f
+    integer, intent(out) :: ios
+    character(len=*), intent(inout) :: msg
+    if (f%single) then
+      write (u, iostat=ios, iomsg=msg) nbytes(4, size(f%v, kind=int64)), real(f%v, real32)
+    else
+      write (u, iostat=ios, iomsg=msg) nbytes(8, size(f%v, kind=int64)), f%v
+    end if
+  end subroutine write_field
 
   !> One <DataArray .../> line for appended data at offset; advances offset past this
   !> array's block (8-byte length header + nbytes of values).
