@@ -327,7 +327,7 @@ contains
           call give_up(r, r%err%message); return
         end if
         st%t = real(i, dp)/deck%run%load_steps; st%step = i
-        call account(r%model, r%asm, st, r%fext*st%t, r%q0, r%bal)
+        call account(r%model, r%asm, st, r%fext*st%t, r%q0, r%bal, factor=st%t)   ! (issue 17)
         call history_row(r, r%rep%iters)
         if (failed(r, 'history')) return
         call frame(r)

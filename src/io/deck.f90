@@ -5,7 +5,8 @@
 !>   &restraint  (any number) prescribed parameters of a body's nodes: a box, a node list or
 !>               a named set (a physical group of the body's mesh file)
 !>   &load       (any number) a dead force on a body's nodes (box, list or set): shared equally
-!>               ('nodal') or a uniform line load on the selected boundary edge ('edge')
+!>               ('nodal') or a uniform line load on the selected boundary edge ('edge'); or a
+!>               follower pressure on the elements whose nodes are all selected ('pressure')
 !>   &contact    contact pairs, surfaces and tolerances
 !>   &obstacle   (any number) a rigid plane, sphere or cylinder, fixed or moving
 !> Every problem found while reading is collected (file:line: group: message) so that the
@@ -91,6 +92,7 @@ module casca_deck
     character(len=64) :: set = ''               !< a physical group of the body's mesh file
     character(len=16) :: kind = 'nodal'         !< 'nodal': shared equally; 'edge': line load
     real(dp) :: force(3) = 0                    !< total
+    real(dp) :: pressure = 0                    !< kind 'pressure' [Pa], along the normal
     integer :: line = 0
   end type load_cfg_t
 
@@ -319,16 +321,16 @@ contains
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
       character(len=long) :: body, set, kind
-      real(dp) :: box_min(3), box_max(3), force(3)
+      real(dp) :: box_min(3), box_max(3), force(3), pressure
       integer :: nodes(max_set)
-      namelist /load/ body, box_min, box_max, force, nodes, set, kind
+      namelist /load/ body, box_min, box_max, force, nodes, set, kind, pressure
       type(load_cfg_t) :: l
       integer :: il
       rewind (uu)
       do il = 1, count(gname == 'load')
         l = load_cfg_t()
         body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force; nodes = 0
-        set = l%set; kind = l%kind
+        set = l%set; kind = l%kind; pressure = l%pressure
         read (uu, nml=load, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('load', il), '&load: '//trim(msg))
@@ -338,7 +340,7 @@ contains
         call take(dk, l%line, '&load: body', body, l%body)
         call take(dk, l%line, '&load: set', set, l%set)
         call take(dk, l%line, '&load: kind', lower(kind), l%kind)
-        l%box_min = box_min; l%box_max = box_max; l%force = force
+        l%box_min = box_min; l%box_max = box_max; l%force = force; l%pressure = pressure
         l%nodes = pack(nodes, nodes /= 0)
         dk%loads = [dk%loads, l]
       end do

@@ -36,7 +36,7 @@ module casca_deck_lint
     key_t('restraint', 'box_max', 'r'), key_t('restraint', 'nodes', 'i'), &
     key_t('load', 'body', 's'), key_t('load', 'set', 's'), key_t('load', 'kind', 's'), &
     key_t('load', 'box_min', 'r'), key_t('load', 'box_max', 'r'), key_t('load', 'force', 'r'), &
-    key_t('load', 'nodes', 'i'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
+    key_t('load', 'nodes', 'i'), key_t('load', 'pressure', 'r'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
     key_t('contact', 'normal', 's'), key_t('contact', 'surface', 's'), &
     key_t('contact', 'tolerance', 'r'), key_t('contact', 'friction', 'r'), &
     key_t('contact', 'static_friction', 'r'), key_t('contact', 'pair_friction', 'r'), &
