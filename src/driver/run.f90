@@ -581,7 +581,8 @@ contains
       print '(a)', timer_report(wall_time() - r%t0)
       if (deck%run%analysis /= 'static' .and. r%restart_step < 0) then
         print '(a)', balance_summary(r%bal0, r%bal, model%length, any(model%fixed) .or. &
-                                     any(r%fext /= 0) .or. size(deck%obstacles) > 0)
+                                     any(r%fext /= 0) .or. size(deck%obstacles) > 0 .or. &
+                                     any(model%pressure /= 0))   ! (issue 17)
         print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact))
       end if
     end associate

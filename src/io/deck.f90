@@ -44,6 +44,7 @@ module casca_deck
     integer :: max_step_cuts = 4
     logical :: reuse_factorisation = .true.     !< modified Newton while it contracts fast
     logical :: skip_idle_bodies = .true.        !< advance bodies in free flight without solving
+    logical :: load_stiffness = .true.          !< the follower pressures' load stiffness in Newton
     real(dp) :: gravity(3) = 0
     character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
     integer :: line = 0
@@ -440,16 +441,18 @@ contains
     character(len=long) :: title, analysis, ordering
     real(dp) :: dt, t_end, beta, gamma, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
-    logical :: reuse_factorisation, skip_idle_bodies
+    logical :: reuse_factorisation, skip_idle_bodies, load_stiffness
     character(len=256) :: msg
     namelist /run/ title, analysis, dt, t_end, beta, gamma, newton_tol, newton_max_iter, &
-      load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies
+      load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies, &
+      load_stiffness
     associate (c => deck%run)
       title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = c%beta
       gamma = c%gamma; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
       ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
       skip_idle_bodies = c%skip_idle_bodies
+      load_stiffness = c%load_stiffness
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -465,6 +468,7 @@ contains
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
       c%reuse_factorisation = reuse_factorisation
       c%skip_idle_bodies = skip_idle_bodies
+      c%load_stiffness = load_stiffness
     end associate
   end subroutine read_run
 

@@ -19,7 +19,8 @@ module casca_deck_lint
     key_t('run', 'gamma', 'r'), key_t('run', 'newton_tol', 'r'), key_t('run', 'gravity', 'r'), &
     key_t('run', 'newton_max_iter', 'i'), key_t('run', 'load_steps', 'i'), &
     key_t('run', 'max_step_cuts', 'i'), key_t('run', 'reuse_factorisation', 'l'), &
-    key_t('run', 'skip_idle_bodies', 'l'), key_t('output', 'dir', 's'), &
+    key_t('run', 'skip_idle_bodies', 'l'), key_t('run', 'load_stiffness', 'l'), &
+    key_t('output', 'dir', 's'), &
     key_t('output', 'track_body', 's'), key_t('output', 'interval', 'r'), &
     key_t('output', 'checkpoint_interval', 'r'), key_t('output', 'track', 'r'), &
     key_t('output', 'vtu', 'l'), key_t('output', 'plots', 'l'), key_t('body', 'name', 's'), &

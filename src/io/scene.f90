@@ -144,6 +144,7 @@ contains
     do k = 1, model%nbody
       model%body(k)%gravity = deck%run%gravity + deck%bodies(k)%gravity
     end do
+    model%load_stiffness = deck%run%load_stiffness
   end subroutine build_model
 
   !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),

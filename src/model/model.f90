@@ -38,6 +38,7 @@ module casca_model
     logical, allocatable :: fixed(:)         !< (ndof) prescribed parameters
     real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
     real(dp), allocatable :: pressure(:)     !< (nelem) follower pressure on each element [Pa]
+    logical :: load_stiffness = .true.       !< the pressures' load stiffness in the tangent
     real(dp) :: length = 1                   !< size of the scene (bounding-box diagonal)
   end type model_t
 

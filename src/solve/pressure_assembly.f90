@@ -23,6 +23,7 @@ contains
   !> element's symmetric part is added. scale: the largest entry of factor f_p on the free
   !> parameters, the load's share of the scene's force scale (0 without pressure).
   !> The elements are those assemble used for the same want_k (collective: every rank calls).
+  !> Without model%load_stiffness the tangent is left as it is (to show what it is worth).
   subroutine add_pressure(model, asm, q, want_k, r, scale, factor)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
@@ -34,11 +35,13 @@ contains
     real(dp), allocatable :: fp(:)
     real(dp) :: lf, y(3, 10), f(3, 10), k(3, 10, 3, 10)
     integer :: i, e, l, p, row, col, ca, cb
+    logical :: stiff
 
     scale = 0
     if (all(model%pressure == 0)) return
     lf = 1
     if (present(factor)) lf = factor
+    stiff = want_k .and. model%load_stiffness
     allocate (fp(model%ndof))
     fp = 0
     do i = 1, merge(size(asm%elems), size(asm%dealt), want_k)
@@ -49,13 +52,13 @@ contains
       end if
       if (model%pressure(e) == 0) cycle
       call element_positions(model, q, e, y)
-      call pressure_force(model%rule, lf*model%pressure(e), y, want_k, f, k)
+      call pressure_force(model%rule, lf*model%pressure(e), y, stiff, f, k)
       do l = 1, 10
         associate (n => model%conn(l, e))
           fp(dof(n, 1):dof(n, 3)) = fp(dof(n, 1):dof(n, 3)) + f(:, l)
         end associate
       end do
-      if (.not. want_k) cycle
+      if (.not. stiff) cycle
       do p = asm%estart(i), asm%estart(i + 1) - 1
         row = mod(asm%pos(p) - 1, ndof_elem); col = (asm%pos(p) - 1)/ndof_elem   ! (from 0)
         ca = mod(row, ndof_node) + 1; cb = mod(col, ndof_node) + 1
