@@ -33,6 +33,7 @@ contains
     real(dp), intent(out) :: scale
     real(dp), intent(in), optional :: factor   !< load factor (statics); default 1
     real(dp), allocatable :: fp(:)
+    integer, allocatable :: elems(:)   !< assemble's for want_k: the tangent's, else dealt round
     real(dp) :: lf, y(3, 10), f(3, 10), k(3, 10, 3, 10)
     integer :: i, e, l, p, row, col, ca, cb
     logical :: stiff
@@ -44,12 +45,13 @@ contains
     stiff = want_k .and. model%load_stiffness
     allocate (fp(model%ndof))
     fp = 0
-    do i = 1, merge(size(asm%elems), size(asm%dealt), want_k)
-      if (want_k) then
-        e = asm%elems(i)
-      else
-        e = asm%dealt(i)
-      end if
+    if (want_k) then
+      elems = asm%elems
+    else
+      elems = asm%dealt
+    end if
+    do i = 1, size(elems)
+      e = elems(i)
       if (model%pressure(e) == 0) cycle
       call element_positions(model, q, e, y)
       call pressure_force(model%rule, lf*model%pressure(e), y, stiff, f, k)
