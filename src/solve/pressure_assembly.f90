@@ -19,7 +19,8 @@ contains
   !> external load at the current iterate, r = f_int - f_ext. The element load stiffness K_p
   !> is unsymmetric, but over a closed surface (or one whose boundary is held) the assembled
   !> one is symmetric: the element's skew part is a boundary integral that cancels between
-  !> neighbours. casca's matrices are symmetric (MUMPS takes the lower triangle), so the
+  !> neighbours (exactly on flat elements; to the area rule's accuracy on curved ones, where
+  !> the rule does not integrate it exactly). casca's matrices are symmetric (MUMPS takes the lower triangle), so the
   !> element's symmetric part is added. scale: the largest entry of factor f_p on the free
   !> parameters, the load's share of the scene's force scale (0 without pressure).
   !> The elements are those assemble used for the same want_k (collective: every rank calls).
