@@ -362,7 +362,7 @@ contains
           call give_up(r, r%err%message); return
         end if
         st%t = real(i, dp)/deck%run%load_steps; st%step = i
-        call account(r%model, r%asm, st, r%fext*st%t, r%q0, r%bal)
+        call account(r%model, r%asm, st, r%fext*st%t, r%q0, r%bal, factor=st%t)   ! (issue 17)
         call history_row(r, r%rep%iters)
         if (failed(r, 'history')) return
         call frame(r)
@@ -665,7 +665,8 @@ contains
       print '(a)', timer_report(wall_time() - r%t0)
       if (deck%run%analysis /= 'static' .and. r%restart_step < 0) then
         print '(a)', balance_summary(r%bal0, r%bal, model%length, any(model%fixed) .or. &
-                                     any(r%fext /= 0) .or. size(deck%obstacles) > 0)
+                                     any(r%fext /= 0) .or. size(deck%obstacles) > 0 .or. &
+                                     any(model%pressure /= 0))   ! (issue 17)
         print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact))
       end if
     end associate

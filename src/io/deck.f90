@@ -5,7 +5,8 @@
 !>   &restraint  (any number) prescribed parameters of a body's nodes: a box, a node list or
 !>               a named set (a physical group of the body's mesh file)
 !>   &load       (any number) a dead force on a body's nodes (box, list or set): shared equally
-!>               ('nodal') or a uniform line load on the selected boundary edge ('edge')
+!>               ('nodal') or a uniform line load on the selected boundary edge ('edge'); or a
+!>               follower pressure on the elements whose nodes are all selected ('pressure')
 !>   &contact    contact pairs, surfaces and tolerances
 !>   &obstacle   (any number) a rigid plane, sphere or cylinder, fixed or moving
 !> Every problem found while reading is collected (file:line: group: message) so that the
@@ -46,6 +47,7 @@ module casca_deck
     integer :: max_step_cuts = 4
     logical :: reuse_factorisation = .true.     !< modified Newton while it contracts fast
     logical :: skip_idle_bodies = .true.        !< advance bodies in free flight without solving
+    logical :: load_stiffness = .true.          !< the follower pressures' load stiffness in Newton
     real(dp) :: gravity(3) = 0
     character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
     integer :: line = 0
@@ -94,6 +96,7 @@ module casca_deck
     character(len=64) :: set = ''               !< a physical group of the body's mesh file
     character(len=16) :: kind = 'nodal'         !< 'nodal': shared equally; 'edge': line load
     real(dp) :: force(3) = 0                    !< total
+    real(dp) :: pressure = 0                    !< kind 'pressure' [Pa], along the normal
     integer :: line = 0
   end type load_cfg_t
 
@@ -322,16 +325,16 @@ contains
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
       character(len=long) :: body, set, kind
-      real(dp) :: box_min(3), box_max(3), force(3)
+      real(dp) :: box_min(3), box_max(3), force(3), pressure
       integer :: nodes(max_set)
-      namelist /load/ body, box_min, box_max, force, nodes, set, kind
+      namelist /load/ body, box_min, box_max, force, nodes, set, kind, pressure
       type(load_cfg_t) :: l
       integer :: il
       rewind (uu)
       do il = 1, count(gname == 'load')
         l = load_cfg_t()
         body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force; nodes = 0
-        set = l%set; kind = l%kind
+        set = l%set; kind = l%kind; pressure = l%pressure
         read (uu, nml=load, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('load', il), '&load: '//trim(msg))
@@ -341,7 +344,7 @@ contains
         call take(dk, l%line, '&load: body', body, l%body)
         call take(dk, l%line, '&load: set', set, l%set)
         call take(dk, l%line, '&load: kind', lower(kind), l%kind)
-        l%box_min = box_min; l%box_max = box_max; l%force = force
+        l%box_min = box_min; l%box_max = box_max; l%force = force; l%pressure = pressure
         l%nodes = pack(nodes, nodes /= 0)
         dk%loads = [dk%loads, l]
       end do
@@ -441,10 +444,11 @@ contains
     character(len=long) :: title, analysis, ordering
     real(dp) :: dt, t_end, beta, gamma, rho_inf, tolerance, tolerance_length, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
-    logical :: reuse_factorisation, skip_idle_bodies
+    logical :: reuse_factorisation, skip_idle_bodies, load_stiffness
     character(len=256) :: msg
     namelist /run/ title, analysis, dt, t_end, beta, gamma, rho_inf, tolerance, tolerance_length, &
-      newton_tol, newton_max_iter, load_steps, max_step_cuts, gravity, ordering, reuse_factorisation, skip_idle_bodies
+      newton_tol, newton_max_iter, load_steps, max_step_cuts, gravity, ordering, &
+      reuse_factorisation, skip_idle_bodies, load_stiffness
     associate (c => deck%run)
       ! (beta and gamma read as unset: given with rho_inf they are refused, not overridden)
       title = c%title; analysis = c%analysis; dt = c%dt; t_end = c%t_end; beta = unset
@@ -453,6 +457,7 @@ contains
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
       ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
       skip_idle_bodies = c%skip_idle_bodies
+      load_stiffness = c%load_stiffness
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -473,6 +478,7 @@ contains
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
       c%reuse_factorisation = reuse_factorisation
       c%skip_idle_bodies = skip_idle_bodies
+      c%load_stiffness = load_stiffness
     end associate
   end subroutine read_run
 

@@ -21,7 +21,8 @@ module casca_deck_lint
     key_t('run', 'tolerance_length', 'r'), &
     key_t('run', 'newton_max_iter', 'i'), key_t('run', 'load_steps', 'i'), &
     key_t('run', 'max_step_cuts', 'i'), key_t('run', 'reuse_factorisation', 'l'), &
-    key_t('run', 'skip_idle_bodies', 'l'), key_t('output', 'dir', 's'), &
+    key_t('run', 'skip_idle_bodies', 'l'), key_t('run', 'load_stiffness', 'l'), &
+    key_t('output', 'dir', 's'), &
     key_t('output', 'track_body', 's'), key_t('output', 'interval', 'r'), &
     key_t('output', 'checkpoint_interval', 'r'), key_t('output', 'track', 'r'), &
     key_t('output', 'vtu', 'l'), key_t('output', 'plots', 'l'), key_t('body', 'name', 's'), &
@@ -38,7 +39,7 @@ module casca_deck_lint
     key_t('restraint', 'box_max', 'r'), key_t('restraint', 'nodes', 'i'), &
     key_t('load', 'body', 's'), key_t('load', 'set', 's'), key_t('load', 'kind', 's'), &
     key_t('load', 'box_min', 'r'), key_t('load', 'box_max', 'r'), key_t('load', 'force', 'r'), &
-    key_t('load', 'nodes', 'i'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
+    key_t('load', 'nodes', 'i'), key_t('load', 'pressure', 'r'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
     key_t('contact', 'normal', 's'), key_t('contact', 'surface', 's'), &
     key_t('contact', 'tolerance', 'r'), key_t('contact', 'friction', 'r'), &
     key_t('contact', 'static_friction', 'r'), key_t('contact', 'pair_friction', 'r'), &

@@ -1,7 +1,7 @@
 !> Nodes a deck group selects (&restraint, &load): a node list within a body, a named set (a
 !> physical group of the body's mesh file) or a box of initial positions (within a body, or
-!> over every body); and the consistent nodal shares of a uniform line load on the boundary
-!> edges of a selection. Messages name the group and say what was asked; the caller adds the
+!> over every body); the consistent nodal shares of a uniform line load on the boundary
+!> edges of a selection; and the elements a selection covers (a surface load's). Messages name the group and say what was asked; the caller adds the
 !> deck's file and line.
 module casca_node_selection
   use casca_kinds, only: dp
@@ -12,7 +12,7 @@ module casca_node_selection
   use casca_strings, only: itoa
   implicit none
   private
-  public :: body_sets_t, select_nodes, edge_shares
+  public :: body_sets_t, select_nodes, edge_shares, selected_elements
 
   !> the named sets of one body, in the body's own node numbering
   type :: body_sets_t
@@ -170,6 +170,22 @@ contains
     end if
     w = w/total
   end subroutine edge_shares
+
+  !> The elements whose 10 nodes are all in sel (a surface load's elements). None is an error.
+  subroutine selected_elements(model, group, sel, elems, err)
+    type(model_t), intent(in) :: model
+    character(len=*), intent(in) :: group
+    integer, intent(in) :: sel(:)
+    integer, allocatable, intent(out) :: elems(:)
+    type(error_t), allocatable, intent(out) :: err
+    logical :: in(model%nnode)
+    integer :: e
+    in = .false.
+    in(sel) = .true.
+    elems = pack([(e, e=1, model%nelem)], [(all(in(model%conn(:, e))), e=1, model%nelem)])
+    if (size(elems) == 0) call fatal_error(err, group//': kind = ''pressure'' needs an element '// &
+                                           'with its 10 nodes selected; the selection holds none')
+  end subroutine selected_elements
 
   !> Cubic Lagrange functions (and their derivatives) of nodes at s = 0, 1/3, 2/3, 1.
   pure subroutine lagrange4(s, n, dn)

@@ -169,8 +169,14 @@ contains
         if (size(l%nodes) > 0 .and. l%body == '') call add_problem(deck, l%line, &
           '&load: nodes needs body = ... (node numbers count within a body)')
         call check_selection(l%line, '&load', l%body, l%set, size(l%nodes), l%box_min, l%box_max)
-        if (l%kind /= 'nodal' .and. l%kind /= 'edge') call add_problem(deck, l%line, &
-          '&load: kind = '''//trim(l%kind)//''' (use nodal or edge)')
+        if (l%kind /= 'nodal' .and. l%kind /= 'edge' .and. l%kind /= 'pressure') &
+          call add_problem(deck, l%line, '&load: kind = '''//trim(l%kind)// &
+                           ''' (use nodal, edge or pressure)')
+        if (l%kind == 'pressure' .and. any(l%force /= 0)) call add_problem(deck, l%line, &
+          '&load: kind = ''pressure'' takes pressure = ..., not force')
+        if (l%kind /= 'pressure' .and. l%pressure /= 0) call add_problem(deck, l%line, &
+          '&load: pressure needs kind = ''pressure''')
+        call finite(l%line, '&load: pressure', [l%pressure])
         if (any(l%box_min > l%box_max)) call add_problem(deck, l%line, &
           '&load: box_min must not exceed box_max')
         if (any(ieee_is_nan([l%box_min, l%box_max]))) call add_problem(deck, l%line, &

@@ -9,7 +9,7 @@ module casca_scene
   use casca_deck, only: deck_t, add_problem, deck_file, unset
   use casca_sanity, only: parse_fix
   use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
-  use casca_node_selection, only: body_sets_t, select_nodes, edge_shares
+  use casca_node_selection, only: body_sets_t, select_nodes, edge_shares, selected_elements
   use casca_newmark, only: state_t
   use casca_vectors, only: cross
   use casca_obstacle, only: obstacle_t
@@ -71,7 +71,7 @@ contains
     type(error_t), allocatable :: err
     logical :: comps(7), ok
     integer :: ib, i, n, c, k
-    integer, allocatable :: sel(:)
+    integer, allocatable :: sel(:), elems(:)
     real(dp), allocatable :: share(:)
     type(body_sets_t) :: sets(size(deck%bodies))
 
@@ -119,7 +119,13 @@ contains
       associate (l => deck%loads(i))
         call select_nodes(model, sets, '&load', l%body, l%nodes, l%set, l%box_min, l%box_max, &
                           sel, err)
-        if (.not. allocated(err)) then
+        if (.not. allocated(err) .and. l%kind == 'pressure') then   ! (whole elements, no force)
+          call selected_elements(model, '&load', sel, elems, err)
+          if (.not. allocated(err)) then
+            model%pressure(elems) = model%pressure(elems) + l%pressure
+            cycle
+          end if
+        else if (.not. allocated(err)) then
           if (l%kind == 'edge') then
             call edge_shares(model, '&load', sel, share, err)
           else
@@ -138,6 +144,7 @@ contains
     do k = 1, model%nbody
       model%body(k)%gravity = deck%run%gravity + deck%bodies(k)%gravity
     end do
+    model%load_stiffness = deck%run%load_stiffness
   end subroutine build_model
 
   !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),

@@ -1,5 +1,6 @@
 !> A scene as the solver sees it: all bodies' nodes and elements in one numbering, materials,
-!> element reference data (A0^-1, w det A0, mass), prescribed parameters and dead loads.
+!> element reference data (A0^-1, w det A0, mass), prescribed parameters, dead loads and
+!> follower pressures.
 !> Parameters of node i are dofs 7(i-1)+1..7(i-1)+7 = [Y(3), G(3), A].
 module casca_model
   use casca_kinds, only: dp
@@ -36,6 +37,8 @@ module casca_model
     real(dp), allocatable :: emass(:, :, :)  !< (20, 20, nelem) scalar element mass
     logical, allocatable :: fixed(:)         !< (ndof) prescribed parameters
     real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
+    real(dp), allocatable :: pressure(:)     !< (nelem) follower pressure on each element [Pa]
+    logical :: load_stiffness = .true.       !< the pressures' load stiffness in the tangent
     real(dp) :: length = 1                   !< size of the scene (bounding-box diagonal)
   end type model_t
 
@@ -152,6 +155,8 @@ contains
     end do
     allocate (model%fixed(model%ndof), model%fext(model%ndof))
     model%fixed = .false.; model%fext = 0
+    allocate (model%pressure(model%nelem))
+    model%pressure = 0
     model%length = norm2(maxval(model%x0, dim=2) - minval(model%x0, dim=2))
   end subroutine model_finalize
 

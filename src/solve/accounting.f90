@@ -1,10 +1,12 @@
-!> Energy and momentum of a state: kinetic energy, strain energy, work of the dead loads,
+!> Energy and momentum of a state: kinetic energy, strain energy, work of the dead loads and
+!> of the follower pressures (p (V - V0): casca_pressure_assembly),
 !> linear and angular momentum, all from the constant consistent mass (no lumping); kinetic
 !> and strain energy also per body, the totals being their sums.
 module casca_accounting
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t, strain_energy_local
+  use casca_pressure_assembly, only: pressure_work_local
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
   use casca_vectors, only: cross
@@ -28,20 +30,28 @@ module casca_accounting
 
 contains
 
-  !> fext: the dead load; q0: the state where its work is zero.
-  subroutine account(model, asm, st, fext, q0, bal)
+  !> fext: the dead load; q0: the state where its work is zero; factor: the pressures'
+  !> load factor (statics; default 1). The pressures' work is p (V - V0), a function of the
+  !> state, not a sum over the steps: the work exactly when each loaded surface is closed or
+  !> its boundary held (then the follower pressure is conservative), restart-proof, and in
+  !> statics alike the dead loads' fext . (q - q0) at the current factor.
+  subroutine account(model, asm, st, fext, q0, bal, factor)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(in) :: asm
     type(state_t), intent(in) :: st
     real(dp), intent(in) :: fext(:), q0(:)
     type(balance_t), intent(out) :: bal
-    real(dp) :: x(3, 20), v(3, 20), mv(3, 20)
-    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), p, L: one reduction
+    real(dp), intent(in), optional :: factor
+    real(dp) :: x(3, 20), v(3, 20), mv(3, 20), lf
+    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), p, L, pressure work
     integer :: i, e, p, b, nb
 
     nb = model%nbody
-    allocate (s(2*nb + 6))
+    allocate (s(2*nb + 7))
     s = 0
+    lf = 1
+    if (present(factor)) lf = factor
+    s(2*nb + 7) = pressure_work_local(model, asm%owned, st%q, q0, lf)
     call strain_energy_local(model, asm, st%q, s(nb + 1:2*nb))
     do i = 1, size(asm%owned)   ! every body: frozen ones move too
       e = asm%owned(i)
@@ -59,7 +69,7 @@ contains
     bal%body_kinetic = s(1:nb); bal%body_strain = s(nb + 1:2*nb)
     bal%kinetic = sum(bal%body_kinetic); bal%strain = sum(bal%body_strain)
     bal%p = s(2*nb + 1:2*nb + 3); bal%l = s(2*nb + 4:2*nb + 6)
-    bal%work = dot_product(fext, st%q - q0)
+    bal%work = dot_product(fext, st%q - q0) + s(2*nb + 7)
     bal%total = bal%kinetic + bal%strain - bal%work
   contains
     !> the 20 vector parameters (Y^l, G^l) of element e from a full-length vector

@@ -145,7 +145,8 @@ contains
     at = from; level = 0; iters = 0
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
-      call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact)
+      call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
+                        load_factor=at + step)   ! the pressures scaled too (issue 17)
       if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
       if (allocated(err)) then
         if (level >= max_cuts) then

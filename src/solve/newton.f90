@@ -21,6 +21,7 @@ module casca_newton
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t, assemble
+  use casca_pressure_assembly, only: add_pressure   ! follower pressure (issue 17)
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
                                  kkt_solve, negative_pivots
   use casca_contact, only: contact_t, constraint_t
@@ -72,7 +73,7 @@ module casca_newton
 contains
 
   !> On failure (err allocated) q and the contact's active set are as they were at entry.
-  subroutine newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, qn, af)
+  subroutine newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, qn, af, load_factor)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     type(linear_system_t), intent(inout) :: ls
@@ -84,12 +85,13 @@ contains
     real(dp), intent(in), optional :: cm, qs(:)
     type(contact_t), intent(inout), optional :: contact
     real(dp), intent(in), optional :: qn(:), af   !< generalized-alpha: f_int at (1-af) q + af qn
+    real(dp), intent(in), optional :: load_factor   !< of the pressures (statics; default 1)
     real(dp), allocatable :: r(:), res(:), q_entry(:)
     type(constraint_t), allocatable :: act_entry(:)
     type(rows_t) :: rows
     type(increment_t) :: inc
     integer :: it, nc, version
-    real(dp) :: fref, ffloor, rnorm
+    real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
     logical :: fresh, refresh_next
 
     if (asm%neq_total == 0) then   ! every body is frozen this step: nothing to solve
@@ -115,6 +117,7 @@ contains
       call timer_start(t_assembly)
       call assemble(model, asm, q, fresh, r, rep%energy, cm, qs, qn, af)
       r = r - fext
+      call add_pressure(model, asm, q, fresh, r, fpress, load_factor, qn, af)   ! pressure (issue 17)
       call timer_stop(t_assembly)
       if (fresh) then
         call timer_start(t_factor)
@@ -180,7 +183,7 @@ contains
       end if
       where (model%fixed) res = 0
       rnorm = maxval(abs(res))
-      fref = max(maxval(abs(fext)), maxval(abs(r + fext), mask=.not. model%fixed), &
+      fref = max(maxval(abs(fext)), fpress, maxval(abs(r + fext), mask=.not. model%fixed), &
                  maxval(abs(res - r), mask=.not. model%fixed))
     end subroutine full_residual
 

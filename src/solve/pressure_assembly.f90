@@ -1,0 +1,117 @@
+!> The follower pressure of the model's loaded elements (model%pressure) in Newton's
+!> residual and tangent, and its work for the energy accounting. The elements are split
+!> over the ranks as casca_assembly splits them: the force is summed over the ranks and each
+!> rank adds the load stiffness to its own elements' matrix entries.
+module casca_pressure_assembly
+  use casca_kinds, only: dp
+  use casca_model, only: model_t, dof
+  use casca_assembly, only: assembly_t
+  use casca_shell_element, only: ndof_elem, ndof_node
+  use casca_pressure_load, only: pressure_force, pressure_volume
+  use casca_mpi, only: sum_all
+  implicit none
+  private
+  public :: add_pressure, pressure_work_local
+
+contains
+
+  !> r -= factor f_p(q) and, with want_k, asm%a -= factor sym(K_p): the pressure is an
+  !> external load at the current iterate, r = f_int - f_ext. The element load stiffness K_p
+  !> is unsymmetric, but over a closed surface (or one whose boundary is held) the assembled
+  !> one is symmetric: the element's skew part is a boundary integral that cancels between
+  !> neighbours (exactly on flat elements; to the area rule's accuracy on curved ones, where
+  !> the rule does not integrate it exactly). casca's matrices are symmetric (MUMPS takes the lower triangle), so the
+  !> element's symmetric part is added. scale: the largest entry of factor f_p on the free
+  !> parameters, the load's share of the scene's force scale (0 without pressure).
+  !> The elements are those assemble used for the same want_k (collective: every rank calls).
+  !> Without model%load_stiffness the tangent is left as it is (to show what it is worth).
+  subroutine add_pressure(model, asm, q, want_k, r, scale, factor, qn, af)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    real(dp), intent(in) :: q(:)
+    logical, intent(in) :: want_k
+    real(dp), intent(inout) :: r(:)
+    real(dp), intent(out) :: scale
+    real(dp), intent(in), optional :: factor   !< load factor (statics); default 1
+    real(dp), intent(in), optional :: qn(:), af   !< generalized-alpha: at (1-af) q + af qn,
+                                                  !< as the internal force (casca_assembly)
+    real(dp), allocatable :: fp(:), qa(:)
+    real(dp) :: w
+    integer, allocatable :: elems(:)   !< assemble's for want_k: the tangent's, else dealt round
+    real(dp) :: lf, y(3, 10), f(3, 10), k(3, 10, 3, 10)
+    integer :: i, e, l, p, row, col, ca, cb
+    logical :: stiff
+
+    scale = 0
+    if (all(model%pressure == 0)) return
+    lf = 1
+    if (present(factor)) lf = factor
+    stiff = want_k .and. model%load_stiffness
+    w = 0
+    if (present(af) .and. present(qn)) w = af
+    qa = (1 - w)*q
+    if (w /= 0) qa = qa + w*qn
+    allocate (fp(model%ndof))
+    fp = 0
+    if (want_k) then
+      elems = asm%elems
+    else
+      elems = asm%dealt
+    end if
+    do i = 1, size(elems)
+      e = elems(i)
+      if (model%pressure(e) == 0) cycle
+      call element_positions(model, qa, e, y)
+      call pressure_force(model%rule, lf*model%pressure(e), y, stiff, f, k)
+      do l = 1, 10
+        associate (n => model%conn(l, e))
+          fp(dof(n, 1):dof(n, 3)) = fp(dof(n, 1):dof(n, 3)) + f(:, l)
+        end associate
+      end do
+      if (.not. stiff) cycle
+      do p = asm%estart(i), asm%estart(i + 1) - 1
+        row = mod(asm%pos(p) - 1, ndof_elem); col = (asm%pos(p) - 1)/ndof_elem   ! (from 0)
+        ca = mod(row, ndof_node) + 1; cb = mod(col, ndof_node) + 1
+        if (ca > 3 .or. cb > 3) cycle   ! (only positions carry it)
+        asm%a(p) = asm%a(p) - 0.5_dp*(1 - w)*(k(ca, row/ndof_node + 1, cb, col/ndof_node + 1) + &
+                                              k(cb, col/ndof_node + 1, ca, row/ndof_node + 1))
+      end do
+    end do
+    call sum_all(fp)
+    r = r - fp
+    scale = maxval(abs(fp), mask=.not. model%fixed, dim=1)
+    scale = max(scale, 0._dp)   ! (every parameter fixed: maxval of nothing)
+  end subroutine add_pressure
+
+  !> This rank's share of the pressure's work at q from q0, factor sum p (V(q) - V(q0))
+  !> over elems (pressure_volume): the work exactly when the loaded surface is closed or its
+  !> boundary is held (docs/method.md); not summed over the ranks.
+  real(dp) function pressure_work_local(model, elems, q, q0, factor) result(w)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: elems(:)
+    real(dp), intent(in) :: q(:), q0(:), factor
+    real(dp) :: y(3, 10), y0(3, 10)
+    integer :: i, e
+    w = 0
+    do i = 1, size(elems)
+      e = elems(i)
+      if (model%pressure(e) == 0) cycle
+      call element_positions(model, q, e, y)
+      call element_positions(model, q0, e, y0)
+      w = w + model%pressure(e)*(pressure_volume(model%rule, y) - pressure_volume(model%rule, y0))
+    end do
+    w = factor*w
+  end function pressure_work_local
+
+  !> the positions Y of element e's 10 nodes from a full-length vector
+  pure subroutine element_positions(model, q, e, y)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    integer, intent(in) :: e
+    real(dp), intent(out) :: y(3, 10)
+    integer :: l
+    do l = 1, 10
+      y(:, l) = q(dof(model%conn(l, e), 1):dof(model%conn(l, e), 3))
+    end do
+  end subroutine element_positions
+end module casca_pressure_assembly
