@@ -1,0 +1,285 @@
+!> What `casca check` says about a built scene before it runs (LS-DYNA's and OpenRadioss'
+!> starter, Abaqus' datacheck): per body its size, mass, smallest element, element quality and
+!> the step its elements suggest; the time step against them; the equations' size; and
+!> warnings that leave the deck runnable: normals pointing into a closed body, distorted
+!> elements, pairs that never meet, steps a node can cross the contact band in.
+!>
+!> Every figure comes from the model as built (reference positions, element data, mass):
+!>   mass      the sum of the consistent mass's Y-Y entries of one component (rho times the
+!>             element volume, its thickness integrated through the reference fibres)
+!>   area      the cubic mid-surface, 7-point rule
+!>   l_min     the shortest edge between an element's vertex nodes
+!>   quality   the element's min/max of the area Jacobian |dX/dxi1 x dX/dxi2| over the 7
+!>             points: 1 for straight-sided elements with evenly spaced edge nodes, falls as
+!>             edge or centre nodes move off their places (aspect ratio does not lower it)
+!>   c         sqrt(E / (rho (1 - nu^2))), the membrane (plate) wave speed
+!>   step      omega_max ~ 2 c / l_min (an element estimate of the highest membrane
+!>             frequency), explicit stable step ~ l_min / c; estimates, not eigenvalues
+module casca_starter
+  use casca_kinds, only: dp
+  use casca_mesh, only: nen
+  use casca_deck, only: deck_t
+  use casca_model, only: model_t, element_dofs, area_points
+  use casca_shape_tri10, only: tri10_normal
+  use casca_orientation, only: edge_census_t, edge_census, signed_volume
+  use casca_strings, only: itoa, rtoa, count_of
+  use casca_scene, only: scene_contact, initial_state
+  use casca_newmark, only: state_t
+  use casca_contact, only: contact_t, search_radius
+  use casca_pair_gaps, only: pair_gap_t, pair_gaps_at
+  use casca_sanity, only: bytes_per_element
+  implicit none
+  private
+  public :: body_facts_t, body_facts, starter_report, element_quality, min_quality
+
+  !> Below this element quality a warning names the element: the area scale of its map then
+  !> varies by more than a factor 2 over it
+  real(dp), parameter :: min_quality = 0.5_dp
+  !> Steps per period a vibration needs to be followed by the implicit step
+  real(dp), parameter :: steps_per_period = 10
+
+  !> One body's figures
+  type :: body_facts_t
+    integer :: nodes = 0, elements = 0
+    real(dp) :: mass = 0, area = 0          !< [kg], [m^2]
+    real(dp) :: lo(3) = 0, hi(3) = 0        !< bounding box [m]
+    real(dp) :: l_min = 0                   !< shortest vertex-to-vertex edge [m]
+    real(dp) :: quality = 1                 !< worst element quality ...
+    integer :: worst = 0                    !< ... and its element (within the body)
+    integer :: distorted = 0                !< elements below min_quality
+    real(dp) :: c = 0                       !< membrane wave speed [m/s]
+    type(edge_census_t) :: edges            !< orientation and closure of its mesh
+    real(dp) :: volume = 0                  !< enclosed, signed by the normals (closed meshes)
+  end type body_facts_t
+
+contains
+
+  !> Body b's figures
+  function body_facts(model, b) result(f)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    type(body_facts_t) :: f
+    integer :: e
+    real(dp) :: q
+    associate (bd => model%body(b), x => model%x0(:, model%body(b)%node_first:model%body(b)%node_last))
+      f%nodes = bd%node_last - bd%node_first + 1
+      f%elements = bd%elem_last - bd%elem_first + 1
+      f%lo = minval(x, dim=2); f%hi = maxval(x, dim=2)
+      f%l_min = huge(1._dp)
+      f%quality = huge(1._dp)
+      do e = bd%elem_first, bd%elem_last
+        f%mass = f%mass + sum(model%emass(1:nen, 1:nen, e))
+        f%area = f%area + element_area(model, e)
+        f%l_min = min(f%l_min, shortest_edge(model%x0(:, model%conn(1:3, e))))
+        q = element_quality(model, e)
+        if (q < min_quality) f%distorted = f%distorted + 1
+        if (q < f%quality) then
+          f%quality = q; f%worst = e - bd%elem_first + 1
+        end if
+      end do
+      f%c = sqrt(bd%young/(bd%density*(1 - bd%poisson**2)))
+      associate (conn => model%conn(:, bd%elem_first:bd%elem_last) - bd%node_first + 1)
+        f%edges = edge_census(conn, f%nodes)
+        if (f%edges%open == 0) f%volume = signed_volume(x, conn)
+      end associate
+    end associate
+  end function body_facts
+
+  !> Area of element e's cubic mid-surface (the model's area rule)
+  pure real(dp) function element_area(model, e) result(a)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: e
+    integer :: ia
+    a = 0
+    do ia = 1, area_points
+      a = a + model%rule%wa(ia)*norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
+    end do
+  end function element_area
+
+  !> Element e's min/max of the area Jacobian over the model's area points
+  pure real(dp) function element_quality(model, e) result(q)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: e
+    real(dp) :: j(area_points)
+    integer :: ia
+    do ia = 1, area_points
+      j(ia) = norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
+    end do
+    q = minval(j)/maxval(j)
+  end function element_quality
+
+  !> Shortest side of the triangle of vertices xv(3, 3)
+  pure real(dp) function shortest_edge(xv) result(l)
+    real(dp), intent(in) :: xv(3, 3)
+    l = min(norm2(xv(:, 1) - xv(:, 2)), norm2(xv(:, 2) - xv(:, 3)), norm2(xv(:, 3) - xv(:, 1)))
+  end function shortest_edge
+
+  !> The starter's report of a built scene: the facts to unit out, the warnings to unit err
+  subroutine starter_report(deck, model, out, err)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: out, err
+    type(body_facts_t) :: f(model%nbody)
+    integer :: b, k
+    character(len=:), allocatable :: w(:)
+    do b = 1, model%nbody
+      f(b) = body_facts(model, b)
+    end do
+    write (out, '(a)') 'bodies (mass from the consistent mass matrix; l_min: shortest edge '// &
+      'between vertex nodes; quality: min/max of the area Jacobian over an element''s 7 '// &
+      'points, worst element; c = sqrt(E/(rho (1 - nu^2))), the membrane wave speed; '// &
+      'steps are element estimates):'
+    do b = 1, model%nbody
+      call body_lines(model, b, f(b), out)
+    end do
+    if (deck%run%analysis == 'dynamic') call step_line(deck, model, f, out)
+    call memory_line(model, out)
+    w = [body_warnings(model, f), pair_warnings(deck, model)]
+    do k = 1, size(w)
+      write (err, '(a)') 'warning: '//trim(w(k))
+    end do
+  end subroutine starter_report
+
+  !> Body b's lines of the report
+  subroutine body_lines(model, b, f, u)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b, u
+    type(body_facts_t), intent(in) :: f
+    character(len=24) :: mass
+    character(len=:), allocatable :: shape
+    write (mass, '(es19.12)') f%mass
+    if (f%edges%open > 0) then
+      shape = 'open ('//count_of(f%edges%open, 'boundary edge', 'boundary edges')//')'
+    else
+      shape = 'closed, enclosing '//rtoa(abs(f%volume))//' m^3, normals '// &
+              trim(merge('outwards', 'inwards ', f%volume > 0))
+    end if
+    associate (bd => model%body(b))
+      write (u, '(a)') '  body '''//bd%name//''': '//count_of(f%nodes, 'node', 'nodes')//', '// &
+        count_of(f%elements, 'element', 'elements')//', thickness '//rtoa(bd%thickness)// &
+        ' m, area '//rtoa(f%area)//' m^2, mass '//trim(adjustl(mass))//' kg'
+      write (u, '(a)') '    box '//vec(f%lo)//' to '//vec(f%hi)//' m, size '// &
+        rtoa(f%hi(1) - f%lo(1))//' x '//rtoa(f%hi(2) - f%lo(2))//' x '//rtoa(f%hi(3) - f%lo(3))// &
+        ' m; mesh '//shape
+      write (u, '(a)') '    l_min '//rtoa(f%l_min)//' m, quality '//rtoa(f%quality)// &
+        ' (element '//itoa(f%worst)//'); c '//rtoa(f%c)//' m/s, highest frequency ~ 2 c / l_min = '// &
+        rtoa(2*f%c/f%l_min)//' rad/s, explicit stable step ~ l_min / c = '//rtoa(f%l_min/f%c)//' s'
+    end associate
+  end subroutine body_lines
+
+  !> The deck's dt against the bodies' explicit estimates, and what it resolves
+  subroutine step_line(deck, model, f, u)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    type(body_facts_t), intent(in) :: f(:)
+    integer, intent(in) :: u
+    real(dp) :: dt, explicit(size(f))
+    integer :: b
+    dt = deck%run%dt
+    explicit = f%l_min/f%c
+    b = minloc(explicit, dim=1)
+    write (u, '(a)') 'time step: dt '//rtoa(dt)//' s is '//rtoa(dt/explicit(b))// &
+      ' times the smallest explicit estimate (body '''//model%body(b)%name//'''); at '// &
+      itoa(nint(steps_per_period))//' steps per period it follows vibrations up to 1/('// &
+      itoa(nint(steps_per_period))//' dt) = '//rtoa(1/(steps_per_period*dt))// &
+      ' Hz, against the highest element frequency ~ 2 c / l_min / (2 pi) = '// &
+      rtoa(f(b)%c/(f(b)%l_min*acos(-1._dp)))//' Hz (the implicit step stays stable; Newmark '// &
+      'with gamma > 1/2 damps what it does not follow)'
+  end subroutine step_line
+
+  !> The equations' size: unknowns, the matrix entries the elements hand to the solver (each
+  !> element's lower triangle of free pairs, assembly.f90), and the memory sanity.f90 budgets
+  subroutine memory_line(model, u)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: u
+    real(dp) :: entries
+    integer :: e, nf
+    entries = 0
+    do e = 1, model%nelem
+      nf = count(.not. model%fixed(element_dofs(model, e)))
+      entries = entries + 0.5_dp*real(nf, dp)*(nf + 1)
+    end do
+    write (u, '(a)') 'equations: '//count_of(count(.not. model%fixed), 'unknown', 'unknowns')// &
+      ', '//rtoa(entries)//' matrix entries from the elements; memory ~ '// &
+      rtoa(model%nelem*bytes_per_element/1e6_dp)//' MB with the factors (40 kB per element, '// &
+      'measured on a sphere of 11,520 elements: docs/performance.md)'
+  end subroutine memory_line
+
+  !> Normals into a closed body, distorted elements
+  function body_warnings(model, f) result(w)
+    type(model_t), intent(in) :: model
+    type(body_facts_t), intent(in) :: f(:)
+    character(len=400), allocatable :: w(:)
+    integer :: b
+    allocate (w(0))
+    do b = 1, size(f)
+      associate (name => model%body(b)%name)
+        if (f(b)%edges%open == 0 .and. f(b)%volume < 0) call add(w, &
+          'body '''//name//''': its mesh is closed and its normals point inwards (the volume '// &
+          'its orientation encloses is '//rtoa(f(b)%volume)//' m^3); contact between '// &
+          'mid-surfaces meets it on its inner side only; &body flip_normals = .true. reverses them')
+        if (f(b)%distorted > 0) call add(w, 'body '''//name//''': '// &
+          count_of(f(b)%distorted, 'element is', 'elements are')//' distorted (quality below '// &
+          rtoa(min_quality)//': the area Jacobian varies by more than a factor 2 over the '// &
+          'element); the worst, element '//itoa(f(b)%worst)//', has '//rtoa(f(b)%quality))
+      end associate
+    end do
+  end function body_warnings
+
+  !> Pairs that never meet at the initial velocities, and pairs whose closing speed carries a
+  !> node across the target's contact band (search_radius: what a step can still detect) in
+  !> one step. Dynamic runs only (statics has no speeds).
+  function pair_warnings(deck, model) result(w)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    character(len=400), allocatable :: w(:)
+    type(contact_t) :: c
+    type(state_t) :: st
+    type(pair_gap_t), allocatable :: pg(:)
+    character(len=:), allocatable :: label
+    real(dp) :: band
+    integer :: p, bi, bt
+    logical :: found
+    allocate (w(0))
+    if (deck%run%analysis /= 'dynamic') return
+    call scene_contact(deck, model, c, found)
+    if (.not. found) return
+    call initial_state(deck, model, st)
+    pg = pair_gaps_at(c, model, st%q, st%qd)
+    do p = 1, c%npairs
+      bi = c%pair(1, p); bt = c%pair(2, p)
+      if (bi == bt .or. pg(p)%node == 0) cycle   ! (self-contact: rigid motion closes nothing)
+      if (bt > 0) then
+        label = 'pair '''//model%body(bi)%name//''' -> '''//model%body(bt)%name//''''
+      else
+        label = 'pair '''//model%body(bi)%name//''' -> '''//trim(c%obstacle(-bt)%name)//''''
+      end if
+      if (pg(p)%time < 0) then
+        call add(w, label//' never meets at the initial velocities (closing '// &
+             'speed '//rtoa(pg(p)%speed)//' m/s): without gravity, loads or another body '// &
+             'it stays apart')
+      else if (bt > 0) then
+        band = search_radius(c, model, bi, bt)
+        if (pg(p)%speed*deck%run%dt > band) call add(w, label// &
+          ' closes '//rtoa(pg(p)%speed*deck%run%dt)//' m in one step (closing speed '// &
+          rtoa(pg(p)%speed)//' m/s), more than the '//rtoa(band)//' m band in which contact '// &
+          'finds a node: a node can cross the target unseen; dt below '// &
+          rtoa(band/pg(p)%speed)//' s keeps it in')
+      end if
+    end do
+  end function pair_warnings
+
+  !> Append text to the list w
+  pure subroutine add(w, text)
+    character(len=*), allocatable, intent(inout) :: w(:)
+    character(len=*), intent(in) :: text
+    w = [character(len=len(w)) :: w, text]
+  end subroutine add
+
+  !> (x, y, z) of a point
+  pure function vec(x) result(s)
+    real(dp), intent(in) :: x(3)
+    character(len=:), allocatable :: s
+    s = '('//rtoa(x(1))//', '//rtoa(x(2))//', '//rtoa(x(3))//')'
+  end function vec
+end module casca_starter
