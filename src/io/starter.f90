@@ -20,7 +20,7 @@ module casca_starter
   use casca_mesh, only: nen
   use casca_deck, only: deck_t
   use casca_model, only: model_t, element_dofs, area_points
-  use casca_shape_tri10, only: tri10_normal
+  use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
   use casca_strings, only: itoa, rtoa, count_of
   use casca_scene, only: scene_contact, initial_state
@@ -92,18 +92,22 @@ contains
     integer :: ia
     a = 0
     do ia = 1, area_points
-      a = a + model%rule%wa(ia)*norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
+      a = a + model%rule%wa(ia)* &
+          norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
     end do
   end function element_area
 
-  !> Element e's min/max of the area Jacobian over the model's area points
+  !> Element e's min/max of the area Jacobian over the model's area points, signed by the
+  !> element's normal at its centroid: below 0 the map folds over inside the element
   pure real(dp) function element_quality(model, e) result(q)
     type(model_t), intent(in) :: model
     integer, intent(in) :: e
-    real(dp) :: j(area_points)
+    real(dp) :: j(area_points), phi(nen), dphi(nen, 2), nc(3)
     integer :: ia
+    call tri10_shape(1._dp/3, 1._dp/3, phi, dphi)
+    nc = tri10_normal(model%x0(:, model%conn(:, e)), dphi)
     do ia = 1, area_points
-      j(ia) = norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
+      j(ia) = dot_product(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)), nc)
     end do
     q = minval(j)/maxval(j)
   end function element_quality
@@ -127,8 +131,8 @@ contains
     end do
     write (out, '(a)') 'bodies (mass from the consistent mass matrix; l_min: shortest edge '// &
       'between vertex nodes; quality: min/max of the area Jacobian over an element''s 7 '// &
-      'points, worst element; c = sqrt(E/(rho (1 - nu^2))), the membrane wave speed; '// &
-      'steps are element estimates):'
+      'points, worst element, < 0 folded; c = sqrt(E/(rho (1 - nu^2))), the membrane wave '// &
+      'speed; steps are element estimates):'
     do b = 1, model%nbody
       call body_lines(model, b, f(b), out)
     end do
@@ -221,7 +225,8 @@ contains
         if (f(b)%distorted > 0) call add(w, 'body '''//name//''': '// &
           count_of(f(b)%distorted, 'element is', 'elements are')//' distorted (quality below '// &
           rtoa(min_quality)//': the area Jacobian varies by more than a factor 2 over the '// &
-          'element); the worst, element '//itoa(f(b)%worst)//', has '//rtoa(f(b)%quality))
+          'element, below 0 it folds over); the worst, element '//itoa(f(b)%worst)//', has '// &
+          rtoa(f(b)%quality))
       end associate
     end do
   end function body_warnings
