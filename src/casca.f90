@@ -185,8 +185,9 @@ contains
         'is closed and its normals point out, the shortest element edge, the worst element', &
         'quality, the membrane wave speed and the explicit step it suggests; the deck''s dt', &
         'against it; the unknowns, matrix entries and memory. Warnings (stderr, exit 0):', &
-        'normals into a closed body, distorted elements, pairs that never meet, a dt that', &
-        'carries a node across the contact band in one step. Writes no file.', &
+        'normals into a closed body, distorted elements, pairs that never meet (nothing', &
+        'sets them moving), a dt that carries a node across the contact band in one step.', &
+        'Writes no file.', &
         'options:', &
         '  -h, --help        this text', &
         'exit codes: 0 the deck can run, 2 it has problems']

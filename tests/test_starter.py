@@ -30,7 +30,8 @@ distorted      one straight-sided element, legs 0.1 m, its centroid node moved b
                the quality (min/max over the 7 Radon points) is computed here: d = 0.005 m
                gives 0.38 (warned: below 0.5), d = 0 gives 1 (not warned); 1e-4.
 never          two rings closing at 6 m/s: no 'never meets' warning; ring1 moving away
-               (-10 m/s against ring2's 4): warned.
+               (-10 m/s against ring2's 4): warned; the same under gravity: not warned (it
+               may bring them together).
 large dt       the closing rings with dt 5e-5 s (3e-4 m per step): no warning; dt 0.05 s
                (0.3 m per step, beyond the band 1.25 h + half a sub-triangle edge < 0.13 m):
                warned, the per-step travel printed as 6 dt (1e-4).
@@ -240,8 +241,8 @@ for d, warned in ((0.005, True), (0.0, False)):
 ring = os.path.join(meshdir, "ring_20x1.msh")
 
 
-def rings(v1, dt, t_end):
-    return f"""&run dt = {dt}, t_end = {t_end} /
+def rings(v1, dt, t_end, gravity="0.0, 0.0, 0.0"):
+    return f"""&run dt = {dt}, t_end = {t_end}, gravity = {gravity} /
 &body name = 'ring1', mesh = 'file', file = '{ring}', velocity = {v1}, 0.0, 0.0, {STEEL}, thickness = 0.05 /
 &body name = 'ring2', mesh = 'file', file = '{ring}', center = 2.1, 0.0, 0.0, velocity = 4.0, 0.0, 0.0,
   {STEEL}, thickness = 0.05 /
@@ -254,6 +255,9 @@ ck.record("rings closing at 6 m/s, dt 5e-5 s: exit 0, no warning", code == 0 and
 code, out, err, b = check("apart", rings(-10.0, 5.0e-5, 1.0e-3))
 ck.record("ring1 moving away: warned 'never meets'", code == 0 and any(
     "'ring1' -> 'ring2' never meets" in w for w in warnings(err)), str(warnings(err)))
+code, out, err, b = check("apart_gravity", rings(-10.0, 5.0e-5, 1.0e-3, "0.0, -9.81, 0.0"))
+ck.record("ring1 moving away under gravity (it may bring them together): no warning",
+          code == 0 and warnings(err) == [], str(warnings(err)))
 code, out, err, b = check("large_dt", rings(10.0, 0.05, 0.1))
 m = re.search(r"'ring1' -> 'ring2' closes (\S+) m in one step", err)
 ck.record("rings closing at 6 m/s, dt 0.05 s: exit 0, warned", code == 0 and m is not None, str(warnings(err)))

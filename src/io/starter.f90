@@ -19,7 +19,7 @@ module casca_starter
   use casca_kinds, only: dp
   use casca_mesh, only: nen
   use casca_deck, only: deck_t
-  use casca_model, only: model_t, element_dofs, area_points
+  use casca_model, only: model_t, dof, element_dofs, area_points
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
   use casca_strings, only: itoa, rtoa, count_of
@@ -231,9 +231,10 @@ contains
     end do
   end function body_warnings
 
-  !> Pairs that never meet at the initial velocities, and pairs whose closing speed carries a
-  !> node across the target's contact band (search_radius: what a step can still detect) in
-  !> one step. Dynamic runs only (statics has no speeds).
+  !> Pairs that never meet at the initial velocities while nothing else can set them moving
+  !> (gravity, a load, a pair with a third body that closes), and pairs whose closing speed
+  !> carries a node across the target's contact band (search_radius: what a step can still
+  !> detect) in one step. Dynamic runs only (statics has no speeds).
   function pair_warnings(deck, model) result(w)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
@@ -242,6 +243,7 @@ contains
     type(state_t) :: st
     type(pair_gap_t), allocatable :: pg(:)
     character(len=:), allocatable :: label
+    logical :: pushed(model%nbody)   ! by gravity, a load or a closing pair
     real(dp) :: band
     integer :: p, bi, bt
     logical :: found
@@ -251,6 +253,17 @@ contains
     if (.not. found) return
     call initial_state(deck, model, st)
     pg = pair_gaps_at(c, model, st%q, st%qd)
+    do bi = 1, model%nbody
+      associate (bd => model%body(bi))
+        pushed(bi) = any(bd%gravity /= 0) .or. &
+                     any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0)
+      end associate
+    end do
+    do p = 1, c%npairs
+      if (pg(p)%time < 0 .or. c%pair(1, p) == c%pair(2, p)) cycle
+      pushed(c%pair(1, p)) = .true.
+      if (c%pair(2, p) > 0) pushed(c%pair(2, p)) = .true.
+    end do
     do p = 1, c%npairs
       bi = c%pair(1, p); bt = c%pair(2, p)
       if (bi == bt .or. pg(p)%node == 0) cycle   ! (self-contact: rigid motion closes nothing)
@@ -260,9 +273,12 @@ contains
         label = 'pair '''//model%body(bi)%name//''' -> '''//trim(c%obstacle(-bt)%name)//''''
       end if
       if (pg(p)%time < 0) then
-        call add(w, label//' never meets at the initial velocities (closing '// &
-             'speed '//rtoa(pg(p)%speed)//' m/s): without gravity, loads or another body '// &
-             'it stays apart')
+        if (pushed(bi)) cycle
+        if (bt > 0) then
+          if (pushed(bt)) cycle
+        end if
+        call add(w, label//' never meets: its closing speed is '//rtoa(pg(p)%speed)// &
+                 ' m/s, and no gravity, load or other pair sets either side moving')
       else if (bt > 0) then
         band = search_radius(c, model, bi, bt)
         if (pg(p)%speed*deck%run%dt > band) call add(w, label// &
