@@ -40,7 +40,7 @@ contains
   !> Every edge between vertex nodes of conn(nen, nelem) (nodes 1..nnode), sorted into
   !> agreeing, disagreeing, open and branching ones. Elements are found through the
   !> elements at each vertex node, so the work is the mesh's size times a vertex's valence.
-  function edge_census(conn, nnode) result(ec)
+  pure function edge_census(conn, nnode) result(ec)
     integer, intent(in) :: conn(:, :), nnode
     type(edge_census_t) :: ec
     integer, allocatable :: start(:), at(:), fill(:)

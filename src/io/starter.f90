@@ -30,7 +30,7 @@ module casca_starter
   use casca_sanity, only: bytes_per_element
   implicit none
   private
-  public :: body_facts_t, body_facts, starter_report, element_quality, min_quality
+  public :: body_facts_t, body_facts, starter_report
 
   !> Below this element quality a warning names the element: the area scale of its map then
   !> varies by more than a factor 2 over it
@@ -55,7 +55,7 @@ module casca_starter
 contains
 
   !> Body b's figures
-  function body_facts(model, b) result(f)
+  pure function body_facts(model, b) result(f)
     type(model_t), intent(in) :: model
     integer, intent(in) :: b
     type(body_facts_t) :: f
@@ -124,8 +124,7 @@ contains
     type(model_t), intent(in) :: model
     integer, intent(in) :: out, err
     type(body_facts_t) :: f(model%nbody)
-    integer :: b, k
-    character(len=:), allocatable :: w(:)
+    integer :: b
     do b = 1, model%nbody
       f(b) = body_facts(model, b)
     end do
@@ -138,11 +137,19 @@ contains
     end do
     if (deck%run%analysis == 'dynamic') call step_line(deck, model, f, out)
     call memory_line(model, out)
-    w = [body_warnings(model, f), pair_warnings(deck, model)]
-    do k = 1, size(w)
-      write (err, '(a)') 'warning: '//trim(w(k))
-    end do
+    call put_warnings(body_warnings(model, f), err)
+    call put_warnings(pair_warnings(deck, model), err)
   end subroutine starter_report
+
+  !> The warning lines w, each 'warning: ...', to unit u
+  subroutine put_warnings(w, u)
+    character(len=*), intent(in) :: w(:)
+    integer, intent(in) :: u
+    integer :: k
+    do k = 1, size(w)
+      write (u, '(a)') 'warning: '//trim(w(k))
+    end do
+  end subroutine put_warnings
 
   !> Body b's lines of the report
   subroutine body_lines(model, b, f, u)
@@ -205,8 +212,8 @@ contains
     end do
     write (u, '(a)') 'equations: '//count_of(count(.not. model%fixed), 'unknown', 'unknowns')// &
       ', '//rtoa(entries)//' matrix entries from the elements; memory ~ '// &
-      rtoa(model%nelem*bytes_per_element/1e6_dp)//' MB with the factors (40 kB per element, '// &
-      'measured on a sphere of 11,520 elements: docs/performance.md)'
+      rtoa(model%nelem*bytes_per_element/1e6_dp)//' MB with the factors (40 kB per element: '// &
+      '36 kB measured on a sphere of 11,520 elements, with a margin; docs/performance.md)'
   end subroutine memory_line
 
   !> Normals into a closed body, distorted elements
