@@ -24,6 +24,9 @@ inward sphere  mesh/sphere_6.msh with every element reversed here (vertices 1 an
 one flipped    mesh/strip_20x1.msh with element 6 reversed: refused (exit 2), the message names
                element 6 and the number of edges it shares with other elements (counted here
                from the file).
+T-junction     three flat elements on one edge (two in a plane, alike, one across): accepted
+               (a branching edge has no orientation to agree on), its 6 boundary edges and
+               1 branching edge reported as built.
 distorted      one straight-sided element, legs 0.1 m, its centroid node moved by
                (d, d) in the plane: the area Jacobian is 1 + grad(phi_10) . (d, d) / 0.1 at
                each point (phi_10 = 27 L1 L2 L3; the determinant of a rank-one update), so
@@ -96,6 +99,18 @@ def reverse_elements(src, dst, which):
     with open(dst, "w") as f:
         f.write("\n".join(lines))
     return tris
+
+
+def write_msh(path, nodes, conn):
+    """an ASCII MSH 4.1 file of the points nodes [(x, y, z)] and 10-node triangles conn
+    (1-based node numbers, Gmsh TRI10 order) on one surface entity"""
+    with open(path, "w") as f:
+        f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 %d 1 %d\n2 1 0 %d\n" % ((len(nodes),) * 3))
+        f.write("".join("%d\n" % (k + 1) for k in range(len(nodes))))
+        f.write("".join("%.17g %.17g %.17g\n" % p for p in nodes))
+        f.write("$EndNodes\n$Elements\n1 %d 1 %d\n2 1 21 %d\n" % ((len(conn),) * 3))
+        f.write("".join("%d %s\n" % (e + 1, " ".join(map(str, c))) for e, c in enumerate(conn)))
+        f.write("$EndElements\n")
 
 
 # plate: mass, area, sizes, equations against the deck's geometry
@@ -193,6 +208,36 @@ if m:
              float(m.group(3)), shared, 1e-12)
 
 
+def tjunction(path):
+    """three flat cubic triangles sharing the edge (0,0,0)-(0.1,0,0): two in the plane z = 0
+    (apexes at y = +-0.1, oriented alike), one in y = 0 (apex at z = 0.1)"""
+    L = 0.1
+    nodes = [(0, 0, 0), (L, 0, 0), (L / 3, 0, 0), (2 * L / 3, 0, 0)]   # the shared edge
+    conn = []
+    def lerp(p, q, t):
+        return tuple(p[i] + t * (q[i] - p[i]) for i in range(3))
+    for apex, reverse in (((0, L, 0), False), ((0, -L, 0), True), ((0, 0, L), False)):
+        k = len(nodes)
+        v1, v2 = nodes[0], nodes[1]
+        nodes += [apex, lerp(v2, apex, 1 / 3), lerp(v2, apex, 2 / 3), lerp(apex, v1, 1 / 3),
+                  lerp(apex, v1, 2 / 3), tuple((v1[i] + v2[i] + apex[i]) / 3 for i in range(3))]
+        c = [1, 2, k + 1, 3, 4, k + 2, k + 3, k + 4, k + 5, k + 6]   # Gmsh TRI10 order, 1-based
+        if reverse:   # vertices 1, 2 swapped
+            c = [c[p - 1] for p in REVERSED]
+        conn.append(c)
+    write_msh(path, nodes, conn)
+
+tj = os.path.join(work, "tjunction.msh")
+tjunction(tj)
+code, out, err, b = check("tjunction", f"""&run dt = 1.0e-5, t_end = 1.0e-3 /
+&body name = 't', mesh = 'file', file = '{tj}', {STEEL}, thickness = 0.001 /
+""")
+ck.record("T-junction (3 elements on one edge, the plane pair alike): accepted (exit 0), no warning",
+          code == 0 and warnings(err) == [], err[-300:])
+ck.record("T-junction: 6 boundary edges and 1 edge of three elements reported",
+          "open (6 boundary edges, 1 edge of three or more elements)" in out)
+
+
 # a distorted element: the quality from the determinant of a rank-one update
 def expected_quality(eta):
     r15 = math.sqrt(15)
@@ -214,12 +259,7 @@ def one_element(d):
     x = [(0.1 * a, 0.1 * b) for a, b in xi]
     x[9] = (x[9][0] + d, x[9][1] + d)
     path = os.path.join(work, "one_%g.msh" % d)
-    with open(path, "w") as f:
-        f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 10 1 10\n2 1 0 10\n")
-        f.write("".join("%d\n" % (k + 1) for k in range(10)))
-        f.write("".join("%.17g %.17g 0\n" % p for p in x))
-        f.write("$EndNodes\n$Elements\n1 1 1 1\n2 1 21 1\n1 " + " ".join(str(k + 1) for k in range(10)))
-        f.write("\n$EndElements\n")
+    write_msh(path, [(a, b, 0.0) for a, b in x], [list(range(1, 11))])
     return path
 
 

@@ -22,7 +22,7 @@ module casca_orientation
 
   !> What the edges between vertex nodes say about a mesh's orientation
   type :: edge_census_t
-    integer :: disagree = 0   !< edges its two elements traverse in the same direction
+    integer :: disagree = 0   !< edges of two elements that traverse them the same way
     integer :: open = 0       !< edges of one element (the mesh's boundary)
     integer :: branch = 0     !< edges of three or more elements
     integer :: elem(2) = 0    !< the first disagreeing pair of elements ...
@@ -38,13 +38,14 @@ contains
   end subroutine reverse_elements
 
   !> Every edge between vertex nodes of conn(nen, nelem) (nodes 1..nnode), sorted into
-  !> agreeing, disagreeing, open and branching ones. Elements are found through the
+  !> agreeing, disagreeing (of two elements), open (of one) and branching (of three or more)
+  !> ones. Elements are found through the
   !> elements at each vertex node, so the work is the mesh's size times a vertex's valence.
   pure function edge_census(conn, nnode) result(ec)
     integer, intent(in) :: conn(:, :), nnode
     type(edge_census_t) :: ec
     integer, allocatable :: start(:), at(:), fill(:)
-    integer :: e, f, i, j, k, a, b, nshare, ja
+    integer :: e, f, i, j, k, a, b, nshare, ja, other
     logical :: lowest
     allocate (start(nnode + 1), fill(nnode))
     start = 0
@@ -66,24 +67,25 @@ contains
     do e = 1, size(conn, 2)
       do j = 1, 3   ! edge a -> b of element e
         a = conn(j, e); b = conn(mod(j, 3) + 1, e)
-        nshare = 0; lowest = .true.
+        nshare = 0; other = 0; lowest = .true.
         do k = start(a), start(a + 1) - 1
           f = at(k)
           if (f == e .or. all(conn(1:3, f) /= b)) cycle
-          nshare = nshare + 1
-          if (f < e) then   ! (each shared edge is counted from its lowest element)
-            lowest = .false.; cycle
-          end if
-          ja = findloc(conn(1:3, f), a, dim=1)
-          if (conn(mod(ja, 3) + 1, f) == b) then   ! f runs a -> b too
-            ec%disagree = ec%disagree + 1
-            if (ec%elem(1) == 0) then
-              ec%elem = [e, f]; ec%node = [a, b]
-            end if
-          end if
+          nshare = nshare + 1; other = f
+          lowest = lowest .and. f > e   ! (each edge is counted from its lowest element)
         end do
         if (nshare == 0) ec%open = ec%open + 1
-        if (nshare > 1 .and. lowest) ec%branch = ec%branch + 1
+        if (.not. lowest) cycle
+        if (nshare > 1) ec%branch = ec%branch + 1
+        if (nshare /= 1) cycle
+        ! (a branching edge, a T-junction of shells, has no orientation to agree on)
+        ja = findloc(conn(1:3, other), a, dim=1)
+        if (conn(mod(ja, 3) + 1, other) == b) then   ! the other element runs a -> b too
+          ec%disagree = ec%disagree + 1
+          if (ec%elem(1) == 0) then
+            ec%elem = [e, other]; ec%node = [a, b]
+          end if
+        end if
       end do
     end do
   end function edge_census

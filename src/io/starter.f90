@@ -49,6 +49,7 @@ module casca_starter
     integer :: distorted = 0                !< elements below min_quality
     real(dp) :: c = 0                       !< membrane wave speed [m/s]
     type(edge_census_t) :: edges            !< orientation and closure of its mesh
+    logical :: closed = .false.             !< every edge of two elements
     real(dp) :: volume = 0                  !< enclosed, signed by the normals (closed meshes)
   end type body_facts_t
 
@@ -80,7 +81,8 @@ contains
       f%c = sqrt(bd%young/(bd%density*(1 - bd%poisson**2)))
       associate (conn => model%conn(:, bd%elem_first:bd%elem_last) - bd%node_first + 1)
         f%edges = edge_census(conn, f%nodes)
-        if (f%edges%open == 0) f%volume = signed_volume(x, conn)
+        f%closed = f%edges%open == 0 .and. f%edges%branch == 0
+        if (f%closed) f%volume = signed_volume(x, conn)
       end associate
     end associate
   end function body_facts
@@ -159,11 +161,14 @@ contains
     character(len=24) :: mass
     character(len=:), allocatable :: shape
     write (mass, '(es19.12)') f%mass
-    if (f%edges%open > 0) then
-      shape = 'open ('//count_of(f%edges%open, 'boundary edge', 'boundary edges')//')'
-    else
+    if (f%closed) then
       shape = 'closed, enclosing '//rtoa(abs(f%volume))//' m^3, normals '// &
               trim(merge('outwards', 'inwards ', f%volume > 0))
+    else
+      shape = 'open ('//count_of(f%edges%open, 'boundary edge', 'boundary edges')
+      if (f%edges%branch > 0) shape = shape//', '//count_of(f%edges%branch, 'edge', 'edges')// &
+                                      ' of three or more elements'
+      shape = shape//')'
     end if
     associate (bd => model%body(b))
       write (u, '(a)') '  body '''//bd%name//''': '//count_of(f%nodes, 'node', 'nodes')//', '// &
@@ -225,7 +230,7 @@ contains
     allocate (w(0))
     do b = 1, size(f)
       associate (name => model%body(b)%name)
-        if (f(b)%edges%open == 0 .and. f(b)%volume < 0) call add(w, &
+        if (f(b)%closed .and. f(b)%volume < 0) call add(w, &
           'body '''//name//''': its mesh is closed and its normals point inwards (the volume '// &
           'its orientation encloses is '//rtoa(f(b)%volume)//' m^3); contact between '// &
           'mid-surfaces meets it on its inner side only; &body flip_normals = .true. reverses them')
