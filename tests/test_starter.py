@@ -7,7 +7,10 @@ plate          a generated plate 0.3 x 0.2 m, 3 x 2 cells, h 0.01 m, steel (rho 
                nu 0.3): mass = rho lx ly h and area = lx ly to 1e-10 (a flat element's mass
                is exact: the mass rule is of degree 6, the integrand of degree 6); l_min = 0.1 m
                (the cells' shorter side); quality 1 (straight-sided elements, nodes at thirds);
-               c = sqrt(E / (rho (1 - nu^2))) and the explicit step l_min / c; unknowns 7 x 70
+               c = sqrt(E / (rho (1 - nu^2))), the fibre-stretch frequency 2 sqrt(3) c_d / h
+               (c_d = sqrt((lambda + 2 mu) / rho); tests/test_starter_freq.f90 holds it against
+               the element's eigenvalues) and the explicit step 2 / (the larger of it and the
+               membrane 2 c / l_min): these are the formulas, evaluated here; unknowns 7 x 70
                nodes and matrix entries 12 elements x 70 x 71 / 2 (each element's lower
                triangle, nothing held); printed to 5 digits: 1e-4. No warning.
 sphere         a generated sphere R 1, h 0.05, rho 7700: mass against rho times the shell's
@@ -53,7 +56,8 @@ ck = Checks()
 STEEL = "young = 210e9, poisson = 0.3, density = 7800"
 BODY = re.compile(r"body '([^']*)': (\d+) nodes?, (\d+) elements?, thickness (\S+) m, area (\S+) m\^2, "
                   r"mass (\S+) kg\n.*mesh (open|closed)[^\n]*\n\s+l_min (\S+) m, quality (\S+) "
-                  r"\(element (\d+)\); c (\S+) m/s.*explicit stable step ~ l_min / c = (\S+) s")
+                  r"\(element (\d+)\); c (\S+) m/s.* 2 sqrt\(3\) c_d / h = (\S+) rad/s; "
+                  r"explicit stable step ~ 2 / omega_max = (\S+) s")
 EQS = re.compile(r"equations: (\d+) unknowns, (\S+) matrix entries")
 REVERSED = [2, 1, 3, 5, 4, 9, 8, 7, 6, 10]   # vertices 1, 2 swapped (Gmsh TRI10 order)
 
@@ -71,7 +75,8 @@ def check(name, text):
         bodies[m.group(1)] = dict(nodes=int(m.group(2)), elements=int(m.group(3)), area=float(m.group(5)),
                                   mass=float(m.group(6)), closed=m.group(7) == "closed",
                                   l_min=float(m.group(8)), quality=float(m.group(9)),
-                                  c=float(m.group(11)), step=float(m.group(12)))
+                                  c=float(m.group(11)), omega_t=float(m.group(12)),
+                                  step=float(m.group(13)))
     return p.returncode, p.stdout, p.stderr, bodies
 
 
@@ -124,12 +129,16 @@ if pl is None:
     ck.record("plate: body line printed", False)
 else:
     c = math.sqrt(E / (rho * (1 - nu ** 2)))
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    omega_t = 2 * math.sqrt(3 * (lam + 2 * mu) / rho) / h
     ck.close("plate: mass = rho lx ly h [kg]", pl["mass"], rho * lx * ly * h, 1e-10)
     ck.close("plate: area = lx ly [m^2]", pl["area"], lx * ly, 1e-4)
     ck.close("plate: l_min = the cells' shorter side [m]", pl["l_min"], 0.1, 1e-4)
     ck.close("plate: quality of straight-sided elements", pl["quality"], 1.0, 1e-4)
     ck.close("plate: c = sqrt(E / (rho (1 - nu^2))) [m/s]", pl["c"], c, 1e-4)
-    ck.close("plate: explicit step l_min / c [s]", pl["step"], 0.1 / c, 1e-4)
+    ck.close("plate: thickness stretch 2 sqrt(3) c_d / h [rad/s]", pl["omega_t"], omega_t, 1e-4)
+    ck.close("plate: explicit step 2 / max(2 c / l_min, 2 sqrt(3) c_d / h) [s]", pl["step"],
+             2 / max(2 * c / 0.1, omega_t), 1e-4)
     ck.record("plate: open mesh", not pl["closed"])
 m = EQS.search(out)
 ck.record("plate: equations line printed", m is not None)

@@ -12,9 +12,14 @@
 !>   quality   the element's min/max of the area Jacobian |dX/dxi1 x dX/dxi2| over the 7
 !>             points: 1 for straight-sided elements with evenly spaced edge nodes, falls as
 !>             edge or centre nodes move off their places (aspect ratio does not lower it)
-!>   c         sqrt(E / (rho (1 - nu^2))), the membrane (plate) wave speed
-!>   step      omega_max ~ 2 c / l_min (an element estimate of the highest membrane
-!>             frequency), explicit stable step ~ l_min / c; estimates, not eigenvalues
+!>   c         sqrt(E / (rho (1 - nu^2))), the membrane (plate) wave speed: membrane waves
+!>             up to ~ 2 c / l_min, an element estimate
+!>   thickness the fibre's stretch through the thickness, ~ 2 sqrt(3) c_d / h (c_d =
+!>             sqrt((lambda + 2 mu) / rho)): stiffness (lambda + 2 mu) h against the fibre's
+!>             inertia rho h^3 / 12 per area. The highest frequency of a shell mesh unless
+!>             its elements are smaller than the thickness (a free plate's: 1.08 to 1.12 times this,
+!>             tests/test_starter_freq.f90)
+!>   step      explicit stable step ~ 2 / omega_max of the two; estimates, not eigenvalues
 module casca_starter
   use casca_kinds, only: dp
   use casca_mesh, only: nen
@@ -30,7 +35,7 @@ module casca_starter
   use casca_sanity, only: bytes_per_element
   implicit none
   private
-  public :: body_facts_t, body_facts, starter_report
+  public :: body_facts_t, body_facts, starter_report, thickness_frequency
 
   !> Below this element quality a warning names the element: the area scale of its map then
   !> varies by more than a factor 2 over it
@@ -48,6 +53,7 @@ module casca_starter
     integer :: worst = 0                    !< ... and its element (within the body)
     integer :: distorted = 0                !< elements below min_quality
     real(dp) :: c = 0                       !< membrane wave speed [m/s]
+    real(dp) :: omega_m = 0, omega_t = 0    !< membrane and thickness estimates [rad/s]
     type(edge_census_t) :: edges            !< orientation and closure of its mesh
     logical :: closed = .false.             !< every edge of two elements
     real(dp) :: volume = 0                  !< enclosed, signed by the normals (closed meshes)
@@ -79,6 +85,8 @@ contains
         end if
       end do
       f%c = sqrt(bd%young/(bd%density*(1 - bd%poisson**2)))
+      f%omega_m = 2*f%c/f%l_min
+      f%omega_t = thickness_frequency(bd%lam, bd%mu, bd%density, bd%thickness)
       associate (conn => model%conn(:, bd%elem_first:bd%elem_last) - bd%node_first + 1)
         f%edges = edge_census(conn, f%nodes)
         f%closed = f%edges%open == 0 .and. f%edges%branch == 0
@@ -86,6 +94,13 @@ contains
       end associate
     end associate
   end function body_facts
+
+  !> The fibre's stretch mode through the thickness h of a shell of Lame constants lam, mu
+  !> and density rho: sqrt(k / m) with k = (lam + 2 mu) h and m = rho h^3 / 12 per area
+  pure real(dp) function thickness_frequency(lam, mu, rho, h) result(omega)
+    real(dp), intent(in) :: lam, mu, rho, h
+    omega = 2*sqrt(3*(lam + 2*mu)/rho)/h
+  end function thickness_frequency
 
   !> Area of element e's cubic mid-surface (the model's area rule)
   pure real(dp) function element_area(model, e) result(a)
@@ -133,7 +148,7 @@ contains
     write (out, '(a)') 'bodies (mass from the consistent mass matrix; l_min: shortest edge '// &
       'between vertex nodes; quality: min/max of the area Jacobian over an element''s 7 '// &
       'points, worst element, < 0 folded; c = sqrt(E/(rho (1 - nu^2))), the membrane wave '// &
-      'speed; steps are element estimates):'
+      'speed; c_d = sqrt((lambda + 2 mu)/rho); frequencies and steps are estimates):'
     do b = 1, model%nbody
       call body_lines(model, b, f(b), out)
     end do
@@ -178,28 +193,29 @@ contains
         rtoa(f%hi(1) - f%lo(1))//' x '//rtoa(f%hi(2) - f%lo(2))//' x '//rtoa(f%hi(3) - f%lo(3))// &
         ' m; mesh '//shape
       write (u, '(a)') '    l_min '//rtoa(f%l_min)//' m, quality '//rtoa(f%quality)// &
-        ' (element '//itoa(f%worst)//'); c '//rtoa(f%c)//' m/s, highest frequency ~ 2 c / l_min = '// &
-        rtoa(2*f%c/f%l_min)//' rad/s, explicit stable step ~ l_min / c = '//rtoa(f%l_min/f%c)//' s'
+        ' (element '//itoa(f%worst)//'); c '//rtoa(f%c)//' m/s: membrane waves up to ~ 2 c / '// &
+        'l_min = '//rtoa(f%omega_m)//' rad/s; the fibre''s stretch through the thickness ~ '// &
+        '2 sqrt(3) c_d / h = '//rtoa(f%omega_t)//' rad/s; explicit stable step ~ 2 / omega_max = '// &
+        rtoa(2/max(f%omega_m, f%omega_t))//' s'
     end associate
   end subroutine body_lines
 
-  !> The deck's dt against the bodies' explicit estimates, and what it resolves
+  !> The deck's dt against the membrane waves of the finest mesh, and what it follows
   subroutine step_line(deck, model, f, u)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
     type(body_facts_t), intent(in) :: f(:)
     integer, intent(in) :: u
-    real(dp) :: dt, explicit(size(f))
+    real(dp) :: dt
     integer :: b
     dt = deck%run%dt
-    explicit = f%l_min/f%c
-    b = minloc(explicit, dim=1)
-    write (u, '(a)') 'time step: dt '//rtoa(dt)//' s is '//rtoa(dt/explicit(b))// &
-      ' times the smallest explicit estimate (body '''//model%body(b)%name//'''); at '// &
-      itoa(nint(steps_per_period))//' steps per period it follows vibrations up to 1/('// &
-      itoa(nint(steps_per_period))//' dt) = '//rtoa(1/(steps_per_period*dt))// &
-      ' Hz, against the highest element frequency ~ 2 c / l_min / (2 pi) = '// &
-      rtoa(f(b)%c/(f(b)%l_min*acos(-1._dp)))//' Hz (the implicit step stays stable; Newmark '// &
+    b = maxloc(f%omega_m, dim=1)
+    write (u, '(a)') 'time step: dt '//rtoa(dt)//' s: membrane waves cross dt c / l_min = '// &
+      rtoa(dt*f(b)%c/f(b)%l_min)//' smallest elements per step (body '''//model%body(b)%name// &
+      '''); at '//itoa(nint(steps_per_period))//' steps per period dt follows vibrations up to '// &
+      rtoa(1/(steps_per_period*dt))//' Hz, membrane waves go up to ~ '// &
+      rtoa(f(b)%omega_m/(2*acos(-1._dp)))//' Hz, the thickness stretch to ~ '// &
+      rtoa(maxval(f%omega_t)/(2*acos(-1._dp)))//' Hz (the implicit step stays stable; Newmark '// &
       'with gamma > 1/2 damps what it does not follow)'
   end subroutine step_line
 
