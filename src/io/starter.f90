@@ -9,16 +9,17 @@
 !>             element volume, its thickness integrated through the reference fibres)
 !>   area      the cubic mid-surface, 7-point rule
 !>   l_min     the shortest edge between an element's vertex nodes
-!>   quality   the element's min/max of the area Jacobian |dX/dxi1 x dX/dxi2| over the 7
-!>             points: 1 for straight-sided elements with evenly spaced edge nodes, falls as
-!>             edge or centre nodes move off their places (aspect ratio does not lower it)
+!>   quality   the element's min/max of the area Jacobian dX/dxi1 x dX/dxi2 (along its
+!>             centroid's normal) over the 7 points: 1 for straight-sided elements with
+!>             evenly spaced edge nodes, falls as edge or centre nodes move off their places,
+!>             below 0 where the element folds over (aspect ratio does not lower it)
 !>   c         sqrt(E / (rho (1 - nu^2))), the membrane (plate) wave speed: membrane waves
 !>             up to ~ 2 c / l_min, an element estimate
 !>   thickness the fibre's stretch through the thickness, ~ 2 sqrt(3) c_d / h (c_d =
 !>             sqrt((lambda + 2 mu) / rho)): stiffness (lambda + 2 mu) h against the fibre's
-!>             inertia rho h^3 / 12 per area. The highest frequency of a shell mesh unless
-!>             its elements are smaller than the thickness (a free plate's: 1.08 to 1.12 times this,
-!>             tests/test_starter_freq.f90)
+!>             inertia rho h^3 / 12 per area. The highest frequency of a shell mesh unless its
+!>             elements are smaller than the thickness (a free plate's highest is 1.08 to 1.12
+!>             times it: tests/test_starter_freq.f90)
 !>   step      explicit stable step ~ 2 / omega_max of the two; estimates, not eigenvalues
 module casca_starter
   use casca_kinds, only: dp
@@ -68,7 +69,8 @@ contains
     type(body_facts_t) :: f
     integer :: e
     real(dp) :: q
-    associate (bd => model%body(b), x => model%x0(:, model%body(b)%node_first:model%body(b)%node_last))
+    associate (bd => model%body(b), &
+               x => model%x0(:, model%body(b)%node_first:model%body(b)%node_last))
       f%nodes = bd%node_last - bd%node_first + 1
       f%elements = bd%elem_last - bd%elem_first + 1
       f%lo = minval(x, dim=2); f%hi = maxval(x, dim=2)
@@ -124,7 +126,8 @@ contains
     call tri10_shape(1._dp/3, 1._dp/3, phi, dphi)
     nc = tri10_normal(model%x0(:, model%conn(:, e)), dphi)
     do ia = 1, area_points
-      j(ia) = dot_product(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)), nc)
+      j(ia) = dot_product(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)), &
+                          nc)
     end do
     q = minval(j)/maxval(j)
   end function element_quality
@@ -195,8 +198,8 @@ contains
       write (u, '(a)') '    l_min '//rtoa(f%l_min)//' m, quality '//rtoa(f%quality)// &
         ' (element '//itoa(f%worst)//'); c '//rtoa(f%c)//' m/s: membrane waves up to ~ 2 c / '// &
         'l_min = '//rtoa(f%omega_m)//' rad/s; the fibre''s stretch through the thickness ~ '// &
-        '2 sqrt(3) c_d / h = '//rtoa(f%omega_t)//' rad/s; explicit stable step ~ 2 / omega_max = '// &
-        rtoa(2/max(f%omega_m, f%omega_t))//' s'
+        '2 sqrt(3) c_d / h = '//rtoa(f%omega_t)//' rad/s; explicit stable step ~ '// &
+        '2 / omega_max = '//rtoa(2/max(f%omega_m, f%omega_t))//' s'
     end associate
   end subroutine body_lines
 
