@@ -22,10 +22,10 @@ module casca_pair_gaps
   use casca_obstacle, only: obstacle_point
   use casca_closest_point, only: closest_point_triangle
   use casca_contact, only: contact_t
-  use casca_contact_projection, only: face
+  use casca_contact_projection, only: face, positions
   implicit none
   private
-  public :: pair_gap_t, pair_gaps, pair_gap_lines
+  public :: pair_gap_t, pair_gaps, pair_gaps_at, pair_gap_lines
 
   !> One pair's figures at t = 0
   type :: pair_gap_t
@@ -108,6 +108,20 @@ contains
       end associate
     end do
   end function pair_gaps
+
+  !> pair_gaps at the parameters q and their rates qd (ndof): positions, fibres, velocities
+  function pair_gaps_at(c, model, q, qd) result(pg)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:), qd(:)
+    type(pair_gap_t) :: pg(c%npairs)
+    real(dp) :: g(3, model%nnode)
+    integer :: n
+    do n = 1, model%nnode
+      g(:, n) = q(dof(n, 4):dof(n, 6))
+    end do
+    pg = pair_gaps(c, model, positions(model, q), g, positions(model, qd))
+  end function pair_gaps_at
 
   !> body b's face along u, as a new constraint chooses it (projection.f90); none between
   !> mid-surfaces. (Module procedures, not internal ones: gfortran gave the binary an

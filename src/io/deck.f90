@@ -77,6 +77,7 @@ module casca_deck
     real(dp) :: young = unset, poisson = 0.3_dp, density = unset, thickness = unset
     real(dp) :: velocity(3) = 0, omega(3) = 0   !< omega about the body's centroid
     real(dp) :: gravity(3) = 0                  !< the body's own, added to &run's
+    logical :: flip_normals = .false.           !< reverse the elements' orientation
     integer :: line = 0
   end type body_cfg_t
 
@@ -262,9 +263,10 @@ contains
       real(dp) :: rotate_axis(3), rotate_angle
       real(dp) :: velocity(3), omega(3), gravity(3)
       integer :: n_around, n_across, n_div, nx, ny, ib
+      logical :: flip_normals
       namelist /body/ name, mesh, file, radius, width, lx, ly, n_around, n_across, n_div, &
         nx, ny, center, rotate_axis, rotate_angle, young, poisson, density, thickness, velocity, omega, &
-        gravity
+        gravity, flip_normals
       type(body_cfg_t) :: b
       rewind (uu)
       do ib = 1, count(gname == 'body')
@@ -274,6 +276,7 @@ contains
         nx = b%nx; ny = b%ny; center = b%center; young = b%young; poisson = b%poisson
         density = b%density; thickness = b%thickness; velocity = b%velocity; omega = b%omega
         rotate_axis = b%rotate_axis; rotate_angle = b%rotate_angle; gravity = b%gravity
+        flip_normals = b%flip_normals
         read (uu, nml=body, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('body', ib), '&body: '//trim(msg))
@@ -288,6 +291,7 @@ contains
         b%nx = nx; b%ny = ny; b%center = center; b%young = young; b%poisson = poisson
         b%density = density; b%thickness = thickness; b%velocity = velocity; b%omega = omega
         b%rotate_axis = rotate_axis; b%rotate_angle = rotate_angle; b%gravity = gravity
+        b%flip_normals = flip_normals
         dk%bodies = [dk%bodies, b]
       end do
     end subroutine read_bodies

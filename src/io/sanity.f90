@@ -10,7 +10,7 @@ module casca_sanity
   use casca_deck_lint, only: did_you_mean
   implicit none
   private
-  public :: check_deck, parse_fix
+  public :: check_deck, parse_fix, bytes_per_element
 
   !> Largest size of a number in a deck: far beyond any scene or material, far below the
   !> overflow of the products casca forms (a 1e308 passed every check and overflowed later)

@@ -14,6 +14,8 @@ module casca_scene
   use casca_vectors, only: cross
   use casca_obstacle, only: obstacle_t
   use casca_contact, only: contact_t, contact_init
+  use casca_orientation, only: reverse_elements, edge_census_t, edge_census
+  use casca_strings, only: itoa
   implicit none
   private
   public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles, &
@@ -21,7 +23,8 @@ module casca_scene
 
 contains
 
-  !> The mesh of body ib as the deck describes it, moved to its centre.
+  !> The mesh of body ib as the deck describes it, moved to its centre (and with flip_normals
+  !> its elements reversed, exact normals too).
   subroutine body_mesh(deck, ib, mesh, err)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: ib
@@ -41,6 +44,10 @@ contains
         call read_gmsh(deck_file(deck, b%file), mesh, err)
       end select
       if (allocated(err)) return
+      if (b%flip_normals) then
+        call reverse_elements(mesh%conn)
+        mesh%normal = -mesh%normal
+      end if
       rot = rotation(b%rotate_axis, b%rotate_angle*acos(-1._dp)/180)
       do i = 1, mesh%nnode
         mesh%x(:, i) = matmul(rot, mesh%x(:, i)) + b%center
@@ -48,6 +55,23 @@ contains
       if (size(mesh%normal, 2) == mesh%nnode) mesh%normal = matmul(rot, mesh%normal)
     end associate
   end subroutine body_mesh
+
+  !> A problem if neighbouring elements of body ib's mesh disagree on its orientation: their
+  !> normals would cancel in the averaged fibres (which then fail as 'degenerate' elements).
+  subroutine check_orientation(deck, ib, mesh)
+    type(deck_t), intent(inout) :: deck
+    integer, intent(in) :: ib
+    type(mesh_t), intent(in) :: mesh
+    type(edge_census_t) :: ec
+    ec = edge_census(mesh%conn, mesh%nnode)
+    if (ec%disagree == 0) return
+    call add_problem(deck, deck%bodies(ib)%line, '&body '//trim(deck%bodies(ib)%name)// &
+      ': the mesh''s triangles are not consistently oriented: elements '//itoa(ec%elem(1))// &
+      ' and '//itoa(ec%elem(2))//' traverse their shared edge (nodes '//itoa(ec%node(1))//', '// &
+      itoa(ec%node(2))//') in the same direction ('//itoa(ec%disagree)//' such edges); '// &
+      'the fibres, averaged from the element normals, would cancel there. Reorient the mesh '// &
+      '(Gmsh: ReverseMesh Surface{...}; on the surfaces that disagree)')
+  end subroutine check_orientation
 
   !> Rodrigues' rotation matrix (identity for a zero angle).
   pure function rotation(axis, angle) result(r)
@@ -87,6 +111,7 @@ contains
                          ': the mesh has no 10-node triangle')
         cycle
       end if
+      call check_orientation(deck, ib, mesh)
       if (allocated(mesh%sets)) then
         call move_alloc(mesh%sets, sets(ib)%sets)
       else

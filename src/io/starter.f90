@@ -1,0 +1,337 @@
+!> What `casca check` says about a built scene before it runs (LS-DYNA's and OpenRadioss'
+!> starter, Abaqus' datacheck): per body its size, mass, smallest element, element quality and
+!> the step its elements suggest; the time step against them; the equations' size; and
+!> warnings that leave the deck runnable: normals pointing into a closed body, distorted
+!> elements, pairs that never meet, steps a node can cross the contact band in.
+!>
+!> Every figure comes from the model as built (reference positions, element data, mass):
+!>   mass      the sum of the consistent mass's Y-Y entries of one component (rho times the
+!>             element volume, its thickness integrated through the reference fibres)
+!>   area      the cubic mid-surface, 7-point rule
+!>   l_min     the shortest edge between an element's vertex nodes
+!>   quality   the element's min/max of the area Jacobian dX/dxi1 x dX/dxi2 (along its
+!>             centroid's normal) over the 7 points: 1 for straight-sided elements with
+!>             evenly spaced edge nodes, falls as edge or centre nodes move off their places,
+!>             below 0 where the element folds over (aspect ratio does not lower it)
+!>   c         sqrt(E / (rho (1 - nu^2))), the membrane (plate) wave speed: membrane waves
+!>             up to ~ 2 c / l_min, an element estimate
+!>   thickness the fibre's stretch through the thickness, ~ 2 sqrt(3) c_d / h (c_d =
+!>             sqrt((lambda + 2 mu) / rho)): stiffness (lambda + 2 mu) h against the fibre's
+!>             inertia rho h^3 / 12 per area. The highest frequency of a shell mesh unless its
+!>             elements are smaller than the thickness (a free plate's highest is 1.08 to 1.12
+!>             times it: tests/test_starter_freq.f90)
+!>   step      explicit stable step ~ 2 / omega_max of the two; estimates, not eigenvalues
+module casca_starter
+  use casca_kinds, only: dp
+  use casca_mesh, only: nen
+  use casca_deck, only: deck_t
+  use casca_model, only: model_t, dof, element_dofs, area_points
+  use casca_shape_tri10, only: tri10_shape, tri10_normal
+  use casca_orientation, only: edge_census_t, edge_census, signed_volume
+  use casca_strings, only: itoa, rtoa, count_of
+  use casca_scene, only: scene_contact, initial_state
+  use casca_newmark, only: state_t
+  use casca_contact, only: contact_t, search_radius
+  use casca_pair_gaps, only: pair_gap_t, pair_gaps_at
+  use casca_sanity, only: bytes_per_element
+  implicit none
+  private
+  public :: body_facts_t, body_facts, starter_report, thickness_frequency
+
+  !> Below this element quality a warning names the element: the area scale of its map then
+  !> varies by more than a factor 2 over it
+  real(dp), parameter :: min_quality = 0.5_dp
+  !> Steps per period a vibration needs to be followed by the implicit step
+  real(dp), parameter :: steps_per_period = 10
+
+  !> One body's figures
+  type :: body_facts_t
+    integer :: nodes = 0, elements = 0
+    real(dp) :: mass = 0, area = 0          !< [kg], [m^2]
+    real(dp) :: lo(3) = 0, hi(3) = 0        !< bounding box [m]
+    real(dp) :: l_min = 0                   !< shortest vertex-to-vertex edge [m]
+    real(dp) :: quality = 1                 !< worst element quality ...
+    integer :: worst = 0                    !< ... and its element (within the body)
+    integer :: distorted = 0                !< elements below min_quality
+    real(dp) :: c = 0                       !< membrane wave speed [m/s]
+    real(dp) :: omega_m = 0, omega_t = 0    !< membrane and thickness estimates [rad/s]
+    type(edge_census_t) :: edges            !< orientation and closure of its mesh
+    logical :: closed = .false.             !< every edge of two elements
+    real(dp) :: volume = 0                  !< enclosed, signed by the normals (closed meshes)
+  end type body_facts_t
+
+contains
+
+  !> Body b's figures
+  pure function body_facts(model, b) result(f)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    type(body_facts_t) :: f
+    integer :: e
+    real(dp) :: q
+    associate (bd => model%body(b), &
+               x => model%x0(:, model%body(b)%node_first:model%body(b)%node_last))
+      f%nodes = bd%node_last - bd%node_first + 1
+      f%elements = bd%elem_last - bd%elem_first + 1
+      f%lo = minval(x, dim=2); f%hi = maxval(x, dim=2)
+      f%l_min = huge(1._dp)
+      f%quality = huge(1._dp)
+      do e = bd%elem_first, bd%elem_last
+        f%mass = f%mass + sum(model%emass(1:nen, 1:nen, e))
+        f%area = f%area + element_area(model, e)
+        f%l_min = min(f%l_min, shortest_edge(model%x0(:, model%conn(1:3, e))))
+        q = element_quality(model, e)
+        if (q < min_quality) f%distorted = f%distorted + 1
+        if (q < f%quality) then
+          f%quality = q; f%worst = e - bd%elem_first + 1
+        end if
+      end do
+      f%c = sqrt(bd%young/(bd%density*(1 - bd%poisson**2)))
+      f%omega_m = 2*f%c/f%l_min
+      f%omega_t = thickness_frequency(bd%lam, bd%mu, bd%density, bd%thickness)
+      associate (conn => model%conn(:, bd%elem_first:bd%elem_last) - bd%node_first + 1)
+        f%edges = edge_census(conn, f%nodes)
+        f%closed = f%edges%open == 0 .and. f%edges%branch == 0
+        if (f%closed) f%volume = signed_volume(x, conn)
+      end associate
+    end associate
+  end function body_facts
+
+  !> The fibre's stretch mode through the thickness h of a shell of Lame constants lam, mu
+  !> and density rho: sqrt(k / m) with k = (lam + 2 mu) h and m = rho h^3 / 12 per area
+  pure real(dp) function thickness_frequency(lam, mu, rho, h) result(omega)
+    real(dp), intent(in) :: lam, mu, rho, h
+    omega = 2*sqrt(3*(lam + 2*mu)/rho)/h
+  end function thickness_frequency
+
+  !> Area of element e's cubic mid-surface (the model's area rule)
+  pure real(dp) function element_area(model, e) result(a)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: e
+    integer :: ia
+    a = 0
+    do ia = 1, area_points
+      a = a + model%rule%wa(ia)* &
+          norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
+    end do
+  end function element_area
+
+  !> Element e's min/max of the area Jacobian over the model's area points, signed by the
+  !> element's normal at its centroid: below 0 the map folds over inside the element
+  pure real(dp) function element_quality(model, e) result(q)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: e
+    real(dp) :: j(area_points), phi(nen), dphi(nen, 2), nc(3)
+    integer :: ia
+    call tri10_shape(1._dp/3, 1._dp/3, phi, dphi)
+    nc = tri10_normal(model%x0(:, model%conn(:, e)), dphi)
+    do ia = 1, area_points
+      j(ia) = dot_product(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)), &
+                          nc)
+    end do
+    q = minval(j)/maxval(j)
+  end function element_quality
+
+  !> Shortest side of the triangle of vertices xv(3, 3)
+  pure real(dp) function shortest_edge(xv) result(l)
+    real(dp), intent(in) :: xv(3, 3)
+    l = min(norm2(xv(:, 1) - xv(:, 2)), norm2(xv(:, 2) - xv(:, 3)), norm2(xv(:, 3) - xv(:, 1)))
+  end function shortest_edge
+
+  !> The starter's report of a built scene: the facts to unit out, the warnings to unit err
+  subroutine starter_report(deck, model, out, err)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: out, err
+    type(body_facts_t) :: f(model%nbody)
+    integer :: b
+    do b = 1, model%nbody
+      f(b) = body_facts(model, b)
+    end do
+    write (out, '(a)') 'bodies (mass from the consistent mass matrix; l_min: shortest edge '// &
+      'between vertex nodes; quality: min/max of the area Jacobian over an element''s 7 '// &
+      'points, worst element, < 0 folded; c = sqrt(E/(rho (1 - nu^2))), the membrane wave '// &
+      'speed; c_d = sqrt((lambda + 2 mu)/rho); frequencies and steps are estimates):'
+    do b = 1, model%nbody
+      call body_lines(model, b, f(b), out)
+    end do
+    if (deck%run%analysis == 'dynamic') call step_line(deck, model, f, out)
+    call memory_line(model, out)
+    call put_warnings(body_warnings(model, f), err)
+    call put_warnings(pair_warnings(deck, model), err)
+  end subroutine starter_report
+
+  !> The warning lines w, each 'warning: ...', to unit u
+  subroutine put_warnings(w, u)
+    character(len=*), intent(in) :: w(:)
+    integer, intent(in) :: u
+    integer :: k
+    do k = 1, size(w)
+      write (u, '(a)') 'warning: '//trim(w(k))
+    end do
+  end subroutine put_warnings
+
+  !> Body b's lines of the report
+  subroutine body_lines(model, b, f, u)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b, u
+    type(body_facts_t), intent(in) :: f
+    character(len=24) :: mass
+    character(len=:), allocatable :: shape
+    write (mass, '(es19.12)') f%mass
+    if (f%closed) then
+      shape = 'closed, enclosing '//rtoa(abs(f%volume))//' m^3, normals '// &
+              trim(merge('outwards', 'inwards ', f%volume > 0))
+    else
+      shape = 'open ('//count_of(f%edges%open, 'boundary edge', 'boundary edges')
+      if (f%edges%branch > 0) shape = shape//', '//count_of(f%edges%branch, 'edge', 'edges')// &
+                                      ' of three or more elements'
+      shape = shape//')'
+    end if
+    associate (bd => model%body(b))
+      write (u, '(a)') '  body '''//bd%name//''': '//count_of(f%nodes, 'node', 'nodes')//', '// &
+        count_of(f%elements, 'element', 'elements')//', thickness '//rtoa(bd%thickness)// &
+        ' m, area '//rtoa(f%area)//' m^2, mass '//trim(adjustl(mass))//' kg'
+      write (u, '(a)') '    box '//vec(f%lo)//' to '//vec(f%hi)//' m, size '// &
+        rtoa(f%hi(1) - f%lo(1))//' x '//rtoa(f%hi(2) - f%lo(2))//' x '//rtoa(f%hi(3) - f%lo(3))// &
+        ' m; mesh '//shape
+      write (u, '(a)') '    l_min '//rtoa(f%l_min)//' m, quality '//rtoa(f%quality)// &
+        ' (element '//itoa(f%worst)//'); c '//rtoa(f%c)//' m/s: membrane waves up to ~ 2 c / '// &
+        'l_min = '//rtoa(f%omega_m)//' rad/s; the fibre''s stretch through the thickness ~ '// &
+        '2 sqrt(3) c_d / h = '//rtoa(f%omega_t)//' rad/s; explicit stable step ~ '// &
+        '2 / omega_max = '//rtoa(2/max(f%omega_m, f%omega_t))//' s'
+    end associate
+  end subroutine body_lines
+
+  !> The deck's dt against the membrane waves of the finest mesh, and what it follows
+  subroutine step_line(deck, model, f, u)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    type(body_facts_t), intent(in) :: f(:)
+    integer, intent(in) :: u
+    real(dp) :: dt
+    integer :: b
+    dt = deck%run%dt
+    b = maxloc(f%omega_m, dim=1)
+    write (u, '(a)') 'time step: dt '//rtoa(dt)//' s: membrane waves cross dt c / l_min = '// &
+      rtoa(dt*f(b)%c/f(b)%l_min)//' smallest elements per step (body '''//model%body(b)%name// &
+      '''); at '//itoa(nint(steps_per_period))//' steps per period dt follows vibrations up to '// &
+      rtoa(1/(steps_per_period*dt))//' Hz, membrane waves go up to ~ '// &
+      rtoa(f(b)%omega_m/(2*acos(-1._dp)))//' Hz, the thickness stretch to ~ '// &
+      rtoa(maxval(f%omega_t)/(2*acos(-1._dp)))//' Hz (the implicit step stays stable; Newmark '// &
+      'with gamma > 1/2 damps what it does not follow)'
+  end subroutine step_line
+
+  !> The equations' size: unknowns, the matrix entries the elements hand to the solver (each
+  !> element's lower triangle of free pairs, assembly.f90), and the memory sanity.f90 budgets
+  subroutine memory_line(model, u)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: u
+    real(dp) :: entries
+    integer :: e, nf
+    entries = 0
+    do e = 1, model%nelem
+      nf = count(.not. model%fixed(element_dofs(model, e)))
+      entries = entries + 0.5_dp*real(nf, dp)*(nf + 1)
+    end do
+    write (u, '(a)') 'equations: '//count_of(count(.not. model%fixed), 'unknown', 'unknowns')// &
+      ', '//rtoa(entries)//' matrix entries from the elements; memory ~ '// &
+      rtoa(model%nelem*bytes_per_element/1e6_dp)//' MB with the factors (40 kB per element: '// &
+      '36 kB measured on a sphere of 11,520 elements, with a margin; docs/performance.md)'
+  end subroutine memory_line
+
+  !> Normals into a closed body, distorted elements
+  function body_warnings(model, f) result(w)
+    type(model_t), intent(in) :: model
+    type(body_facts_t), intent(in) :: f(:)
+    character(len=400), allocatable :: w(:)
+    integer :: b
+    allocate (w(0))
+    do b = 1, size(f)
+      associate (name => model%body(b)%name)
+        if (f(b)%closed .and. f(b)%volume < 0) call add(w, &
+          'body '''//name//''': its mesh is closed and its normals point inwards (the volume '// &
+          'its orientation encloses is '//rtoa(f(b)%volume)//' m^3); contact between '// &
+          'mid-surfaces meets it on its inner side only; &body flip_normals = .true. reverses them')
+        if (f(b)%distorted > 0) call add(w, 'body '''//name//''': '// &
+          count_of(f(b)%distorted, 'element is', 'elements are')//' distorted (quality below '// &
+          rtoa(min_quality)//': the area Jacobian varies by more than a factor 2 over the '// &
+          'element, below 0 it folds over); the worst, element '//itoa(f(b)%worst)//', has '// &
+          rtoa(f(b)%quality))
+      end associate
+    end do
+  end function body_warnings
+
+  !> Pairs that never meet at the initial velocities while nothing else can set them moving
+  !> (gravity, a load, a pair with a third body that closes), and pairs whose closing speed
+  !> carries a node across the target's contact band (search_radius: what a step can still
+  !> detect) in one step. Dynamic runs only (statics has no speeds).
+  function pair_warnings(deck, model) result(w)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    character(len=400), allocatable :: w(:)
+    type(contact_t) :: c
+    type(state_t) :: st
+    type(pair_gap_t), allocatable :: pg(:)
+    character(len=:), allocatable :: label
+    logical :: pushed(model%nbody)   ! by gravity, a load or a closing pair
+    real(dp) :: band
+    integer :: p, bi, bt
+    logical :: found
+    allocate (w(0))
+    if (deck%run%analysis /= 'dynamic') return
+    call scene_contact(deck, model, c, found)
+    if (.not. found) return
+    call initial_state(deck, model, st)
+    pg = pair_gaps_at(c, model, st%q, st%qd)
+    do bi = 1, model%nbody
+      associate (bd => model%body(bi))
+        pushed(bi) = any(bd%gravity /= 0) .or. &
+                     any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0)
+      end associate
+    end do
+    do p = 1, c%npairs
+      if (pg(p)%time < 0 .or. c%pair(1, p) == c%pair(2, p)) cycle
+      pushed(c%pair(1, p)) = .true.
+      if (c%pair(2, p) > 0) pushed(c%pair(2, p)) = .true.
+    end do
+    do p = 1, c%npairs
+      bi = c%pair(1, p); bt = c%pair(2, p)
+      if (bi == bt .or. pg(p)%node == 0) cycle   ! (self-contact: rigid motion closes nothing)
+      if (bt > 0) then
+        label = 'pair '''//model%body(bi)%name//''' -> '''//model%body(bt)%name//''''
+      else
+        label = 'pair '''//model%body(bi)%name//''' -> '''//trim(c%obstacle(-bt)%name)//''''
+      end if
+      if (pg(p)%time < 0) then
+        if (pushed(bi)) cycle
+        if (bt > 0) then
+          if (pushed(bt)) cycle
+        end if
+        call add(w, label//' never meets: its closing speed is '//rtoa(pg(p)%speed)// &
+                 ' m/s, and no gravity, load or other pair sets either side moving')
+      else if (bt > 0) then
+        band = search_radius(c, model, bi, bt)
+        if (pg(p)%speed*deck%run%dt > band) call add(w, label// &
+          ' closes '//rtoa(pg(p)%speed*deck%run%dt)//' m in one step (closing speed '// &
+          rtoa(pg(p)%speed)//' m/s), more than the '//rtoa(band)//' m band in which contact '// &
+          'finds a node: a node can cross the target unseen; dt below '// &
+          rtoa(band/pg(p)%speed)//' s keeps it in')
+      end if
+    end do
+  end function pair_warnings
+
+  !> Append text to the list w
+  pure subroutine add(w, text)
+    character(len=*), allocatable, intent(inout) :: w(:)
+    character(len=*), intent(in) :: text
+    w = [character(len=len(w)) :: w, text]
+  end subroutine add
+
+  !> (x, y, z) of a point
+  pure function vec(x) result(s)
+    real(dp), intent(in) :: x(3)
+    character(len=:), allocatable :: s
+    s = '('//rtoa(x(1))//', '//rtoa(x(2))//', '//rtoa(x(3))//')'
+  end function vec
+end module casca_starter
