@@ -1,4 +1,4 @@
-!> Tests of casca_hdf5_io (src/io/hdf5_io.f90): history table and checkpoints.
+!> Tests of casca_hdf5_io (src/output/hdf5_io.f90): history table and checkpoints.
 !>
 !> Run in a scratch working directory; it leaves there, for tests/test_hdf5_io.py:
 !>   hdf5_io_table.h5    5 columns, 1000 rows: row i (1-based), column j = i*10 + j + 1/3

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Check casca's HDF5 output (src/io/hdf5_io.f90) from the outside, with h5py.
+"""Check casca's HDF5 output (src/output/hdf5_io.f90) from the outside, with h5py.
 
 Usage:
     python3 tests/test_hdf5_io.py TEST_HDF5_IO [OUTDIR]

@@ -1,4 +1,4 @@
-!> The starter's estimate of a shell mesh's highest frequency (src/io/starter.f90) against the
+!> The starter's estimate of a shell mesh's highest frequency (src/scene/starter.f90) against the
 !> eigenvalues of the element: a free flat steel plate 0.4 x 0.4 m, K and M assembled by
 !> casca_assembly at the reference state (M as the difference of K + M and K), the massless
 !> thickness parameters condensed out, omega_max^2 the largest eigenvalue of L^-1 K L^-T

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Check casca's VTU/PVD writer (src/io/vtu_writer.f90) from the outside.
+"""Check casca's VTU/PVD writer (src/output/vtu_writer.f90) from the outside.
 
 Usage:
     python3 tests/test_vtu.py TEST_VTU [OUTDIR]
