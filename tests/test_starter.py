@@ -42,6 +42,10 @@ large dt       the closing rings with dt 5e-5 s (3e-4 m per step): no warning; d
                (0.3 m per step, beyond the band 1.25 h + half a sub-triangle edge < 0.13 m):
                warned, the per-step travel printed as 6 dt (1e-4).
 bad value      flip_normals = 3: exit 2, the message names the deck, its line and the field.
+element_size   generated ring (R 1, width 0.2), sphere (R 0.5) and plate (1 x 0.35) with
+               element_size 0.1: element counts equal those counted from the geometry here
+               (2 ceil(2 pi R / s) ceil(w / s); 20 ceil(R / sin 72deg / s)^2; 2 ceil(lx / s)
+               ceil(ly / s)), and every l_min <= s; with a mesh file: exit 2 naming the key.
 """
 import math
 import os
@@ -320,4 +324,29 @@ code, out, err, b = check("bad_flip", f"""&run dt = 1.0e-5, t_end = 1.0e-3 /
 """)
 ck.record("flip_normals = 3: exit 2, the message names the deck, line 3 and flip_normals",
           code == 2 and re.search(r"bad_flip\.nml:3:.*flip_normals", err) is not None, err[-300:])
+
+# element_size (issue 18): the generators' counts for edges of at most that size, counted here
+# from the geometry (two triangles a cell; a sphere's icosahedron edge R / sin(72 deg))
+SIZE = 0.1
+code, out, err, b = check("element_size", f"""&run dt = 1.0e-4, t_end = 1.0e-3 /
+&body name = 'r', mesh = 'ring', radius = 1.0, width = 0.2, element_size = {SIZE}, {STEEL}, thickness = 0.05 /
+&body name = 's', mesh = 'sphere', radius = 0.5, element_size = {SIZE}, center = 5.0, 0.0, 0.0,
+  {STEEL}, thickness = 0.05 /
+&body name = 'p', mesh = 'plate', lx = 1.0, ly = 0.35, element_size = {SIZE}, center = 0.0, 5.0, 0.0,
+  {STEEL}, thickness = 0.05 /
+&contact enabled = .false. /
+""")
+expected = {"r": 2 * math.ceil(2 * math.pi * 1.0 / SIZE) * math.ceil(0.2 / SIZE),
+            "s": 20 * math.ceil(0.5 / math.sin(0.4 * math.pi) / SIZE) ** 2,
+            "p": 2 * math.ceil(1.0 / SIZE) * math.ceil(0.35 / SIZE)}
+for name, n in expected.items():
+    ck.record("element_size %g: body '%s' has %d elements" % (SIZE, name, n),
+              name in b and b[name]["elements"] == n, str(b.get(name, {}).get("elements")))
+    if name in b:
+        ck.le("element_size %g: body '%s' l_min [m]" % (SIZE, name), b[name]["l_min"], SIZE)
+code, out, err, b = check("element_size_file", f"""&run dt = 1.0e-4, t_end = 1.0e-3 /
+&body name = 'r', mesh = 'file', file = '{ring}', element_size = 0.1, {STEEL}, thickness = 0.05 /
+""")
+ck.record("element_size with a mesh file: exit 2 naming element_size", code == 2 and "element_size" in err,
+          err[-300:])
 ck.finish()

@@ -78,6 +78,7 @@ module casca_deck
     real(dp) :: velocity(3) = 0, omega(3) = 0   !< omega about the body's centroid
     real(dp) :: gravity(3) = 0                  !< the body's own, added to &run's
     logical :: flip_normals = .false.           !< reverse the elements' orientation
+    real(dp) :: element_size = unset            !< given: the generator's counts from it [m]
     integer :: line = 0
   end type body_cfg_t
 
@@ -261,12 +262,12 @@ contains
       character(len=long) :: name, mesh, file
       real(dp) :: radius, width, lx, ly, center(3), young, poisson, density, thickness
       real(dp) :: rotate_axis(3), rotate_angle
-      real(dp) :: velocity(3), omega(3), gravity(3)
+      real(dp) :: velocity(3), omega(3), gravity(3), element_size
       integer :: n_around, n_across, n_div, nx, ny, ib
       logical :: flip_normals
       namelist /body/ name, mesh, file, radius, width, lx, ly, n_around, n_across, n_div, &
         nx, ny, center, rotate_axis, rotate_angle, young, poisson, density, thickness, velocity, omega, &
-        gravity, flip_normals
+        gravity, flip_normals, element_size
       type(body_cfg_t) :: b
       rewind (uu)
       do ib = 1, count(gname == 'body')
@@ -276,7 +277,7 @@ contains
         nx = b%nx; ny = b%ny; center = b%center; young = b%young; poisson = b%poisson
         density = b%density; thickness = b%thickness; velocity = b%velocity; omega = b%omega
         rotate_axis = b%rotate_axis; rotate_angle = b%rotate_angle; gravity = b%gravity
-        flip_normals = b%flip_normals
+        flip_normals = b%flip_normals; element_size = b%element_size
         read (uu, nml=body, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('body', ib), '&body: '//trim(msg))
@@ -291,7 +292,8 @@ contains
         b%nx = nx; b%ny = ny; b%center = center; b%young = young; b%poisson = poisson
         b%density = density; b%thickness = thickness; b%velocity = velocity; b%omega = omega
         b%rotate_axis = rotate_axis; b%rotate_angle = rotate_angle; b%gravity = gravity
-        b%flip_normals = flip_normals
+        b%flip_normals = flip_normals; b%element_size = element_size
+        if (element_size /= unset) call counts_for_size(b)
         dk%bodies = [dk%bodies, b]
       end do
     end subroutine read_bodies
@@ -566,4 +568,29 @@ contains
     end associate
   end subroutine read_contact
 
+  !> A generator's counts for elements of about b%element_size along their edges (at least
+  !> that fine): ring 2 pi R / size around and width / size across, sphere the icosahedron's
+  !> edge (1.0515 R) / size per face edge, plate lx / size by ly / size. Left as they are when
+  !> a size is not positive and finite (the sanity check says so); at most 10^6 per direction
+  !> (the check of the element count refuses the rest).
+  pure subroutine counts_for_size(b)
+    type(body_cfg_t), intent(inout) :: b
+    if (.not. (b%element_size > 0 .and. b%element_size < huge(1._dp))) return
+    select case (b%mesh)
+    case ('ring')
+      b%n_around = max(3, cells(2*acos(-1._dp)*b%radius))
+      b%n_across = cells(b%width)
+    case ('sphere')
+      b%n_div = cells(b%radius/sin(0.4_dp*acos(-1._dp)))
+    case ('plate', 'strip')
+      b%nx = cells(b%lx); b%ny = cells(b%ly)
+    end select
+  contains
+    pure integer function cells(length)
+      real(dp), intent(in) :: length
+      cells = 1
+      if (length > 0) cells = int(min(1e6_dp, max(1._dp, real(ceiling(min(length/b%element_size, &
+                                  1e6_dp)), dp))))
+    end function cells
+  end subroutine counts_for_size
 end module casca_deck

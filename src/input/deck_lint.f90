@@ -34,7 +34,7 @@ module casca_deck_lint
     key_t('body', 'thickness', 'r'), key_t('body', 'velocity', 'r'), key_t('body', 'omega', 'r'), &
     key_t('body', 'gravity', 'r'), key_t('body', 'n_around', 'i'), &
     key_t('body', 'n_across', 'i'), key_t('body', 'n_div', 'i'), key_t('body', 'nx', 'i'), &
-    key_t('body', 'flip_normals', 'l'), &
+    key_t('body', 'flip_normals', 'l'), key_t('body', 'element_size', 'r'), &
     key_t('body', 'ny', 'i'), key_t('restraint', 'body', 's'), key_t('restraint', 'fix', 's'), &
     key_t('restraint', 'set', 's'), key_t('restraint', 'box_min', 'r'), &
     key_t('restraint', 'box_max', 'r'), key_t('restraint', 'nodes', 'i'), &

@@ -108,6 +108,11 @@ contains
           '&body '//trim(b%name)//': poisson must be in (-1, 0.5)')
         if (b%rotate_angle /= 0 .and. .not. norm2(b%rotate_axis) > 0) call add_problem(deck, n, &
           '&body '//trim(b%name)//': rotate_axis must not be zero')
+        if (b%element_size /= unset) then
+          call positive(n, '&body '//trim(b%name)//': element_size', b%element_size)
+          if (b%mesh == 'file') call add_problem(deck, n, '&body '//trim(b%name)// &
+            ': element_size sizes the generators (ring, sphere, plate, strip), not a mesh file')
+        end if
         select case (b%mesh)
         case ('ring')
           call positive(n, '&body '//trim(b%name)//': radius', b%radius)
