@@ -19,6 +19,12 @@ adaptive     the two thesis rings with ring 2 moved to x = 2.0137 m: the facing 
              contact, not stepped over); every frame lands on its 1 ms time to 1e-12 s; linear
              momentum kept to 1e-8; no tensile multiplier (lambda_max <= 0) and no active
              gap beyond the contact tolerance; fewer steps than the 800 of the deck's fixed dt.
+cantilever   a steel strip 1 m x 0.1 m, h 10 mm, poisson 0, clamped at x = 0, under gravity
+             switched on at t = 0, rho_inf = 0.8 with tolerance 1e-6 (first step 1 ms): the
+             period of the tip's vibration (between its upward crossings of the static
+             deflection) is the Euler-Bernoulli first period 2 pi / (1.8751^2 sqrt(E h^2 /
+             (12 rho L^4))) = 0.11969 s within 1%, and the largest tip deflection is twice the
+             static q L^4 / (8 E I) within 3% (a sudden load; the higher modes add about 1%).
 deck         rho_inf given with beta is refused (exit 2, the message names &run, rho_inf and
              beta); rho_inf = 1.5 and tolerance = -1 are refused naming the field.
 """
@@ -84,6 +90,30 @@ if out is not None:
     ck.le("adaptive: largest active gap [m] (contact tolerance 1e-7 x scene size 3.2 m)",
           np.max(h["gap_max"]), 1e-7 * 3.2)
     ck.le("adaptive: steps (the deck's fixed dt: 800)", len(t) - 1, 799)
+
+STRIP_E, STRIP_RHO, STRIP_H, G = 210e9, 7850.0, 0.01, 9.81
+strip = os.path.join(work, "strip.msh")
+p = run([casca, "mesh", "strip", "--lx", "1.0", "--ly", "0.1", "--nx", "10", "--ny", "1", "-o", strip])
+ck.record("cantilever: casca mesh strip (exit 0)", p.returncode == 0, p.stderr[-200:])
+out, _ = run_scene(casca, ck, work, "cantilever", f"""&run dt = 1e-3, t_end = 0.3, rho_inf = 0.8, tolerance = 1e-6,
+  gravity = 0.0, 0.0, {-G} /
+&output interval = 1e-3, vtu = .false., plots = .false., track = 1.0, 0.05, 0.0 /
+&body name = 's', mesh = 'file', file = '{strip}', young = {STRIP_E}, poisson = 0.0, density = {STRIP_RHO},
+  thickness = {STRIP_H} /
+&restraint body = 's', box_min = -0.001, -1.0, -1.0, box_max = 0.001, 1.0, 1.0, fix = 'clamped' /
+""")
+if out is not None:
+    h = history(out)
+    t, z = h["t"], h["p1_z"]
+    static = STRIP_RHO * G * 12 / (8 * STRIP_E * STRIP_H**2)   # q L^4 / (8 E I), L = 1
+    period = 2 * np.pi / (1.875104**2 * np.sqrt(STRIP_E * STRIP_H**2 / (12 * STRIP_RHO)))
+    s = z + static
+    up = np.nonzero((s[:-1] < 0) & (s[1:] >= 0))[0]
+    tc = t[up] - s[up] * (t[up + 1] - t[up]) / (s[up + 1] - s[up])
+    ck.record("cantilever: two upward crossings of the static deflection", tc.size >= 2, str(tc))
+    if tc.size >= 2:
+        ck.close("cantilever: period [s] vs Euler-Bernoulli", tc[1] - tc[0], period, 0.01)
+    ck.close("cantilever: largest tip deflection [m] vs 2 q L^4 / (8 E I)", -np.min(z), 2 * static, 0.03)
 
 
 def refused(name, run_line, words):
