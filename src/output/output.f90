@@ -11,7 +11,7 @@ module casca_output
   use casca_model, only: model_t, dof, element_dofs
   use casca_newmark, only: state_t
   use casca_accounting, only: balance_t
-  use casca_shell_element, only: shell_stress, von_mises
+  use casca_shell_element, only: shell_stress, von_mises, shell_energy_force, ndof_elem
   use casca_shape_tri10, only: tri10_node_xi
   use casca_vtu_writer, only: field_t, field, write_vtu, write_pvd
   use casca_hdf5_io, only: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, &
@@ -350,7 +350,8 @@ contains
     call write_vtu(out%dir//'/'//trim(name), x, model%conn, &
                    [field('displacement', u), field('velocity', v), field('fibre', g), &
                     field('thickness_param', a), extra, point_stress], &
-                   [field('body', body), cell_stress], err)
+                   [field('body', body), field('strain_energy', cell_energy(model, st%q)), &
+                    cell_stress], err)
     if (allocated(err)) return
     out%nframes = out%nframes + 1
     out%files = [character(len=32) :: out%files, name]
@@ -404,6 +405,22 @@ contains
              (field('stress_'//trim(surface(k)), cell(:, :, k), single=.true.), k=1, 3)]
     points = [(field('stress_'//trim(surface(k)), node(:, :, k), single=.true.), k=1, 3)]
   end subroutine stress_fields
+
+  !> Each element's strain energy [J] (per cell: where a body stores its energy; they sum
+  !> to the history's strain_B)
+  function cell_energy(model, q) result(w)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    real(dp) :: w(1, model%nelem), fe(ndof_elem), ke(ndof_elem, ndof_elem)
+    integer :: e, b
+    do e = 1, model%nelem
+      b = model%elem_body(e)
+      call shell_energy_force(model%rule, model%body(b)%thickness, model%body(b)%lam, &
+                              model%body(b)%mu, model%binv(:, :, :, e), model%wdet(:, e), &
+                              reshape(q(element_dofs(model, e)), [7, 10]), .false., w(1, e), fe, ke, &
+                              want_f=.false.)
+    end do
+  end function cell_energy
 
   !> The 6 components of a symmetric tensor in ParaView's order: xx, yy, zz, xy, yz, xz.
   pure function symmetric_components(t) result(c)

@@ -24,7 +24,7 @@
 module casca_starter
   use casca_kinds, only: dp
   use casca_mesh, only: nen
-  use casca_deck, only: deck_t
+  use casca_deck, only: deck_t, unset
   use casca_model, only: model_t, dof, element_dofs, area_points
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
@@ -157,6 +157,7 @@ contains
     end do
     if (deck%run%analysis == 'dynamic') call step_line(deck, model, f, out)
     call memory_line(model, out)
+    if (deck%run%analysis == 'dynamic') call time_line(deck, model, out)
     call put_warnings(body_warnings(model, f), err)
     call put_warnings(pair_warnings(deck, model), err)
   end subroutine starter_report
@@ -239,6 +240,26 @@ contains
       rtoa(model%nelem*bytes_per_element/1e6_dp)//' MB with the factors (40 kB per element: '// &
       '36 kB measured on a sphere of 11,520 elements, with a margin; docs/performance.md)'
   end subroutine memory_line
+
+  !> A rough run time: the steps at the deck's dt times the elements times 0.03 to 0.08 ms
+  !> per element and step, what whole runs took on one rank of a 2-core machine (three
+  !> spheres 0.032 ms: 2,160 elements, 3,334 steps, 228 s; two rings 0.075 ms: 80 elements,
+  !> 800 steps, 6 s; docs/performance.md). Contact, Newton's iterations and the machine
+  !> move it by a factor of two either way.
+  subroutine time_line(deck, model, u)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: u
+    real(dp) :: work
+    work = deck%run%t_end/deck%run%dt*model%nelem
+    write (u, '(a)') 'run time: ~ '//rtoa(0.03e-3_dp*work)//' to '//rtoa(0.08e-3_dp*work)// &
+      ' s on one rank for t_end / dt = '//rtoa(deck%run%t_end/deck%run%dt)//' steps of '// &
+      count_of(model%nelem, 'element', 'elements')//' (0.03 to 0.08 ms per element and step, '// &
+      'measured on whole scenes; contact and Newton move it by 2x either way'// &
+      trim(merge('; with tolerance the steps are chosen as the run goes', &
+                 '                                                     ', &
+                 deck%run%tolerance /= unset))//')'
+  end subroutine time_line
 
   !> Normals into a closed body, distorted elements
   function body_warnings(model, f) result(w)
