@@ -1,11 +1,13 @@
 !> The Schur path's column cache and the choice of 'auto' (issue 18), on two rings that
 !> overlap obliquely (several constraints) with the dynamic tangent K + cm M:
-!>   - a solve whose rows were reordered, one dropped and one changed in value keeps the
-!>     other columns of Z and makes one: its increment equals that of a fresh Z (every column
-!>     made again) to 1e-10 relative;
-!>   - that increment solves the saddle-point system [K C^T; C 0] [x; dl] = [b; -gap]:
-!>     residuals, computed from K's entries and C's rows, within 1e-10 of the largest of the
-!>     forces |b|, |K x|, |C^T dl| and of |gap|;
+!>   - a solve whose rows were reordered, one dropped and one changed in value, with renew,
+!>     keeps the other columns of Z and makes one: its increment equals that of a fresh Z
+!>     (every column made again) to 1e-10 relative, and solves the saddle-point system
+!>     [K C^T; C 0] [x; dl] = [b; -gap]: residuals, computed from K's entries and C's rows,
+!>     within 1e-10 of the largest of the forces |b|, |K x|, |C^T dl| and of |gap|;
+!>   - without renew the changed row keeps its column (none made) and the increment is that
+!>     of the row's old values (fresh Z, residuals with the old row: 1e-10): one consistent,
+!>     approximate system, like K's kept factors;
 !>   - the same rows again keep every column (none made); the factors of K renewed make all;
 !>   - choose_solver: a large set that stays (300 rows, one factorisation) goes to 'saddle'
 !>     and stays there; a small set with a row changing at every iteration stays 'schur' and
@@ -32,9 +34,9 @@ program test_schur
   type(assembly_t) :: asm
   type(contact_t) :: c
   type(linear_system_t) :: ls
-  type(rows_t) :: ra, rb
+  type(rows_t) :: ra, rb, rold
   type(error_t), allocatable :: err
-  real(dp), allocatable :: q(:), r(:), b(:), x0(:), xr(:), xf(:)
+  real(dp), allocatable :: q(:), r(:), b(:), x0(:), xs(:), xr(:), xf(:), xo(:)
   real(dp) :: energy
   integer :: i, nb, added, analyses, kept, made
 
@@ -63,35 +65,50 @@ program test_schur
 
   ! a fresh Z for set A
   allocate (x0(asm%neq + size(ra%gap)))
-  call kkt_solve(ls, asm, ra, rhs(ra), x0, err)
+  call kkt_solve(ls, asm, ra, rhs(ra), .false., x0, err)
   if (allocated(err)) error stop 'solve A'
 
-  ! set B: A's rows reordered, the second dropped, the first changed in value
+  ! set B: A's rows reordered, the second dropped, the last changed in value (old: unchanged)
   nb = size(ra%gap) - 1
-  rb = pick(ra, [(i, i=size(ra%gap), 3, -1), 1])
+  rold = pick(ra, [(i, i=size(ra%gap), 3, -1), 1])
+  rb = rold
   call change_row(rb, nb)
   b = rhs(rb)
-  allocate (xr(asm%neq + nb), xf(asm%neq + nb))
+  allocate (xs(asm%neq + nb), xr(asm%neq + nb), xf(asm%neq + nb), xo(asm%neq + nb))
   kept = ls%cache%kept; made = ls%cache%made
-  call kkt_solve(ls, asm, rb, b, xr, err)
-  if (allocated(err)) error stop 'solve B, kept columns'
-  call check_true('set B: the unchanged rows keep their columns, the changed one is made', &
+  call kkt_solve(ls, asm, rb, b, .false., xs, err)
+  if (allocated(err)) error stop 'solve B, stale row kept'
+  call check_true('set B: every row keeps its column (the changed one with its old values)', &
+                  ls%cache%kept - kept == nb .and. ls%cache%made - made == 0)
+  kept = ls%cache%kept; made = ls%cache%made
+  call kkt_solve(ls, asm, rb, b, .true., xr, err)
+  if (allocated(err)) error stop 'solve B, renewed'
+  call check_true('set B renewed: the unchanged rows keep their columns, the changed one is made', &
                   ls%cache%kept - kept == nb - 1 .and. ls%cache%made - made == 1)
   ls%cache%current = .false.   ! every column made again
-  call kkt_solve(ls, asm, rb, b, xf, err)
+  call kkt_solve(ls, asm, rb, b, .false., xf, err)
   if (allocated(err)) error stop 'solve B, fresh'
   call check_le('increment with kept columns vs a fresh Z (max diff / max |x|)', &
                 maxval(abs(xr - xf))/maxval(abs(xf)), 1e-10_dp)
   call check_le('dlambda with kept columns vs a fresh Z (max diff / max |dl|)', &
                 maxval(abs(xr(asm%neq + 1:) - xf(asm%neq + 1:)))/maxval(abs(xf(asm%neq + 1:))), 1e-10_dp)
-  call residuals(rb, b, xr)
+  call residuals('set B, kept columns', rb, b, xr)
+  ls%cache%current = .false.
+  call kkt_solve(ls, asm, rold, b, .false., xo, err)
+  if (allocated(err)) error stop 'solve B with the old row, fresh'
+  call check_le('stale row kept: the increment of a fresh Z for the old row (max diff / max |x|)', &
+                maxval(abs(xs - xo))/maxval(abs(xo)), 1e-10_dp)
+  call residuals('stale row kept, with the old row', rold, b, xs)
+  call check_true('the changed row changes the increment (the test can tell: > 1e-6 relative)', &
+                  maxval(abs(xs - xf))/maxval(abs(xf)) > 1e-6_dp)
+  call kkt_solve(ls, asm, rb, b, .true., xr, err)   ! the cache back to set B
 
   kept = ls%cache%kept; made = ls%cache%made
-  call kkt_solve(ls, asm, rb, b, xr, err)
+  call kkt_solve(ls, asm, rb, b, .false., xr, err)
   call check_true('the same rows again: every column kept, none made', &
                   ls%cache%made == made .and. ls%cache%kept == kept)
   call factorise_blocks(ls, asm, rb, err)
-  call kkt_solve(ls, asm, rb, b, xr, err)
+  call kkt_solve(ls, asm, rb, b, .false., xr, err)
   call check_true('K factorised again: every column made', ls%cache%made - made == nb)
   call ls%finish()
 
@@ -143,7 +160,8 @@ contains
 
   !> |K x + C^T dl - b| / max(|b|, |K x|, |C^T dl|) and |C x + gap| / |gap|, from K's
   !> entries (lower triangle, one block) and the rows
-  subroutine residuals(rows, bb, x)
+  subroutine residuals(what, rows, bb, x)
+    character(len=*), intent(in) :: what
     type(rows_t), intent(in) :: rows
     real(dp), intent(in) :: bb(:), x(:)
     real(dp), allocatable :: kx(:), ctl(:), g(:)
@@ -160,10 +178,10 @@ contains
       ctl(rows%jcn(e)) = ctl(rows%jcn(e)) + rows%val(e)*x(rows%irn(e))
       g(rows%irn(e) - n) = g(rows%irn(e) - n) + rows%val(e)*x(rows%jcn(e))
     end do
-    call check_le('saddle-point residual, equations: |K x + C^T dl - b| / max(|b|, |K x|, |C^T dl|)', &
+    call check_le(what//': residual |K x + C^T dl - b| / max(|b|, |K x|, |C^T dl|)', &
                   maxval(abs(kx + ctl - bb(1:n)))/max(maxval(abs(bb(1:n))), maxval(abs(kx)), maxval(abs(ctl))), &
                   1e-10_dp)
-    call check_le('saddle-point residual, constraints: |C x + gap| / |gap|', &
+    call check_le(what//': residual |C x + gap| / |gap|', &
                   maxval(abs(g))/maxval(abs(rows%gap)), 1e-10_dp)
   end subroutine residuals
 

@@ -158,17 +158,21 @@ contains
 
   !> The saddle-point solve: b (asm%neq + nc) holds K's right-hand side then -gap; x the
   !> increment of this rank's equations then dlambda (replicated with 'schur'; on the host
-  !> of block 1 with 'saddle'). With 'schur', the columns of Z still valid are kept
-  !> (casca_schur) and only the new rows' are solved for, with b, in one call.
-  subroutine kkt_solve(ls, asm, rows, b, x, err)
+  !> of block 1 with 'saddle'). With 'schur', the columns of Z made with K's factors in use
+  !> are kept for the rows of the same key (casca_schur) and only the new rows' are solved
+  !> for, with b, in one call; renew: a kept row whose values changed since (the contact
+  !> point projected again) is made anew too, as when Newton contracts slowly.
+  subroutine kkt_solve(ls, asm, rows, b, renew, x, err)
     type(linear_system_t), intent(inout) :: ls
     type(assembly_t), intent(in) :: asm
     type(rows_t), intent(in) :: rows
     real(dp), intent(in) :: b(:)
+    logical, intent(in) :: renew
     real(dp), intent(out) :: x(:)
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: bb(:, :), yy(:, :)
     integer, allocatable :: col(:), slot(:)
+    logical, allocatable :: exact(:)
     integer :: nc, e, k
     nc = size(rows%gap)
     if (.not. ls%schur .or. nc == 0) then
@@ -177,8 +181,9 @@ contains
       x = yy(:, 1)
       return
     end if
-    allocate (col(nc), slot(nc))
-    call schur_match(ls%cache, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, col)
+    allocate (col(nc), slot(nc), exact(nc))
+    call schur_match(ls%cache, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, col, exact)
+    if (renew) where (.not. exact) col = 0
     if (all(col == [(k, k=1, nc)]) .and. size(ls%cache%key, 2) == nc) then   ! Z and S as kept
       allocate (yy(asm%neq, 1))
       call solve_blocks(ls, asm, reshape(b(1:asm%neq), [asm%neq, 1]), yy, 0, err)

@@ -202,8 +202,9 @@ contains
     end function residual_estimate
 
     !> a new matrix unless the kept one still contracts the increment fast enough (decided
-    !> from replicated figures, so alike on every rank). With constraints through the Schur
-    !> complement the rows are always exact (only K is kept), so a slower contraction is let by.
+    !> from replicated figures, so alike on every rank). With constraints, slow contraction
+    !> comes first from the rows (their normal is held): Z is renewed first, K only if
+    !> contraction stays poor.
     logical function refresh_needed()
       refresh_needed = refresh_next .or. .not. (opts%reuse .and. ls%solver(1)%factored)
       refresh_next = .false.
@@ -269,13 +270,16 @@ contains
     subroutine take_increment()
       real(dp), allocatable :: b(:), x(:), d(:)
       integer :: i
+      logical :: renew
       allocate (b(asm%neq + nc), x(asm%neq + nc), d(model%ndof + nc))
       do i = 1, model%ndof
         if (asm%eq(i) > 0) b(asm%eq(i)) = -res(i)
       end do
       b(asm%neq + 1:) = -rows%gap
+      renew = .false.
+      if (rep%nincr >= 2) renew = contraction() > 0.25_dp
       call timer_start(t_solve)
-      call kkt_solve(ls, asm, rows, b, x, err)
+      call kkt_solve(ls, asm, rows, b, renew, x, err)
       if (allocated(err)) then
         call timer_stop(t_solve); return
       end if

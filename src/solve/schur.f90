@@ -35,30 +35,33 @@ module casca_schur
 
 contains
 
-  !> For each row of the new set, the cached column it keeps (0: a new column is needed):
-  !> while the factors of K are those the cache was made with, a row of the same key and
-  !> the same entries (match_rows)
-  subroutine schur_match(c, irn, jcn, val, fval, key, col)
+  !> For each row of the new set, the cached column it can keep (0: a new column is needed)
+  !> while the factors of K are those the cache was made with: a row of the same key and
+  !> pattern; exact where its values are the same too (match_rows)
+  subroutine schur_match(c, irn, jcn, val, fval, key, col, exact)
     type(schur_t), intent(in) :: c
     integer, intent(in) :: irn(:), jcn(:), key(:, :)
     real(dp), intent(in) :: val(:), fval(:)
     integer, intent(out) :: col(:)
-    col = 0
+    logical, intent(out) :: exact(:)
+    col = 0; exact = .false.
     if (c%current .and. allocated(c%key)) &
-      call match_rows(c%irn, c%jcn, c%val, c%fval, c%key, irn, jcn, val, fval, key, col)
+      call match_rows(c%irn, c%jcn, c%val, c%fval, c%key, irn, jcn, val, fval, key, col, exact)
   end subroutine schur_match
 
   !> For each new row (entries irn, jcn, val, fval in row order, rows after the equations,
-  !> each ending with its diagonal; key), the old row it equals (0: none): the same key and the same entries, bit for bit.
-  !> Rows mostly keep their order, so the row after the last one matched is tried first.
-  pure subroutine match_rows(oirn, ojcn, oval, ofval, okey, irn, jcn, val, fval, key, col)
+  !> each ending with its diagonal; key), the old row of the same key and pattern (0: none),
+  !> and whether its values are the same too, bit for bit (exact). Rows mostly keep their
+  !> order, so the row after the last one matched is tried first.
+  pure subroutine match_rows(oirn, ojcn, oval, ofval, okey, irn, jcn, val, fval, key, col, exact)
     integer, intent(in) :: oirn(:), ojcn(:), okey(:, :), irn(:), jcn(:), key(:, :)
     real(dp), intent(in) :: oval(:), ofval(:), val(:), fval(:)
     integer, intent(out) :: col(:)
+    logical, intent(out) :: exact(:)
     integer, allocatable :: first(:), ofirst(:)
     logical, allocatable :: taken(:)
     integer :: k, j, guess, nold
-    col = 0
+    col = 0; exact = .false.
     nold = size(okey, 2)
     allocate (taken(nold))
     taken = .false.
@@ -78,6 +81,7 @@ contains
       end if
       if (col(k) > 0) then
         taken(col(k)) = .true.; guess = col(k) + 1
+        exact(k) = same_values(k, col(k))
       end if
     end do
   contains
@@ -88,26 +92,36 @@ contains
       if (taken(j) .or. any(key(:, k) /= okey(:, j))) return
       a = first(k); b = ofirst(j); n = first(k + 1) - a - 1   ! (the last, the row's diagonal,
       if (ofirst(j + 1) - b - 1 /= n) return                 ! is numbered by its place)
-      same_row = all(jcn(a:a + n - 1) == ojcn(b:b + n - 1)) .and. &
-                 all(val(a:a + n - 1) == oval(b:b + n - 1)) .and. &
-                 all(fval(a:a + n - 1) == ofval(b:b + n - 1))
+      same_row = all(jcn(a:a + n - 1) == ojcn(b:b + n - 1))
     end function same_row
+
+    pure logical function same_values(k, j)
+      integer, intent(in) :: k, j
+      integer :: a, b, n
+      a = first(k); b = ofirst(j); n = first(k + 1) - a
+      same_values = all(val(a:a + n - 1) == oval(b:b + n - 1)) .and. &
+                    all(fval(a:a + n - 1) == ofval(b:b + n - 1))
+    end function same_values
   end subroutine match_rows
 
   !> Keep the new rows and Z: column k is the cached column col(k), or, where col(k) = 0,
-  !> the next column of znew (K^-1 B^T of the new rows, in row order). S = C Z is taken over
-  !> where both row and column are kept, computed where either is new, summed over the ranks
-  !> and factorised.
-  !> unsym: B /= C: S is factorised by LU (its inertia is not counted)
+  !> the next column of znew (K^-1 B^T of the new rows, in row order). A kept row keeps the
+  !> values its column was made with (an earlier iterate's, unless exact): Z, S and the
+  !> rows of the cache stay one saddle-point system, an approximate one like K's kept
+  !> factors. S = C Z is taken over where both row and column are kept, computed where
+  !> either is new, summed over the ranks and factorised (by LU when B /= C: sliding friction).
   subroutine schur_store(c, neq, irn, jcn, val, fval, key, col, znew, err)
     type(schur_t), intent(inout) :: c
     integer, intent(in) :: neq, irn(:), jcn(:), key(:, :), col(:)
     real(dp), intent(in) :: val(:), fval(:), znew(:, :)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), allocatable :: z(:, :), cz(:, :)
-    integer :: nc, k, i, m
+    real(dp), allocatable :: z(:, :), cz(:, :), v(:), fv(:)
+    integer, allocatable :: first(:)
+    integer :: nc, k, i, m, n, a, b
     nc = size(key, 2)
     allocate (z(neq, nc), cz(nc, nc))
+    v = val; fv = fval
+    call row_starts(irn, nc, first)
     m = 0
     do k = 1, nc
       if (col(k) > 0) then
@@ -115,6 +129,8 @@ contains
         do i = 1, nc
           if (col(i) > 0) cz(i, k) = c%cz(col(i), col(k))
         end do
+        a = first(k); b = c%first(col(k)); n = first(k + 1) - a
+        v(a:a + n - 1) = c%val(b:b + n - 1); fv(a:a + n - 1) = c%fval(b:b + n - 1)
       else
         m = m + 1
         z(:, k) = znew(:, m)
@@ -122,11 +138,11 @@ contains
     end do
     c%kept = c%kept + (nc - m); c%made = c%made + m
     call move_alloc(z, c%z); call move_alloc(cz, c%cz)
-    c%irn = irn; c%jcn = jcn; c%val = val; c%fval = fval; c%key = key
-    call row_starts(irn, nc, c%first)
+    c%irn = irn; c%jcn = jcn; c%key = key
+    call move_alloc(v, c%val); call move_alloc(fv, c%fval); call move_alloc(first, c%first)
     call new_products(c, neq, col)
     c%current = .true.
-    call factorise_s(c, any(fval /= val), err)
+    call factorise_s(c, any(c%fval /= c%val), err)
   end subroutine schur_store
 
   !> The entries of S = C Z (this rank's part) whose row or column is new (col = 0)

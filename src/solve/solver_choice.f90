@@ -1,6 +1,6 @@
 !> &contact solver = 'auto': the Schur complement of K or the whole saddle-point matrix,
 !> chosen at every Newton iteration from what each would have to redo (docs/performance.md):
-!>  - 'schur' solves K for one column of Z per new or changed constraint row, and for all
+!>  - 'schur' solves K for one column of Z per new constraint row (a new key), and for all
 !>    nc columns after each factorisation of K;
 !>  - 'saddle' analyses and factorises the saddle-point matrix again whenever the constraint
 !>    pattern changes, which costs about as much as c_analysis columns of Z.
@@ -39,14 +39,15 @@ contains
     logical, intent(in) :: refactored, can_saddle
     logical, intent(inout) :: schur
     integer, allocatable :: col(:)
+    logical, allocatable :: exact(:)
     integer :: nc
     logical :: changed
     nc = size(key, 2)
-    allocate (col(nc))
+    allocate (col(nc), exact(nc))
     col = 0
     changed = .true.
     if (allocated(ch%key)) then
-      call match_rows(ch%irn, ch%jcn, ch%val, ch%fval, ch%key, irn, jcn, val, fval, key, col)
+      call match_rows(ch%irn, ch%jcn, ch%val, ch%fval, ch%key, irn, jcn, val, fval, key, col, exact)
       if (size(ch%irn) == size(irn)) changed = any(ch%irn /= irn) .or. any(ch%jcn /= jcn)
     end if
     ch%columns = (1 - weight)*ch%columns + weight*merge(nc, count(col == 0), refactored)
