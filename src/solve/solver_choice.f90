@@ -14,9 +14,10 @@ module casca_solver_choice
   private
   public :: solver_choice_t, choose_solver
 
-  !> a saddle-point analysis and factorisation, in Z columns (plate of 961 nodes, 1 rank:
-  !> 0.17 s against 1.3 ms a column in a batch of 961; docs/performance.md)
-  real(dp), parameter :: c_analysis = 128
+  !> a saddle-point analysis and factorisation, in Z columns: about 400 on a plate of 256
+  !> nodes, 100 on one of 961 (docs/performance.md); 400 keeps 'schur' wherever the set
+  !> keeps changing and still takes 'saddle' for a large set that stays
+  real(dp), parameter :: c_analysis = 400
   real(dp), parameter :: weight = 0.1_dp       !< of the last iteration in the running means
   real(dp), parameter :: horizon = 20          !< iterations a switch must pay for itself in
 
