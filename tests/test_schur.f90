@@ -15,9 +15,7 @@
 program test_schur
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_mesh, only: mesh_t
-  use casca_mesh_generators, only: mesh_ring
-  use casca_model, only: model_t, model_add_body, model_finalize, reference_state
+  use casca_model, only: model_t, reference_state
   use casca_assembly, only: assembly_t, assembly_setup, assemble
   use casca_contact, only: contact_t, contact_init
   use casca_contact_active_set, only: contact_update
@@ -26,10 +24,10 @@ program test_schur
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, kkt_solve
   use casca_solver_choice, only: solver_choice_t, choose_solver
   use casca_mpi, only: mpi_start, mpi_stop
+  use casca_test_rings, only: overlapping_rings
   use casca_check, only: check_le, check_true, check_summary
   implicit none
 
-  type(mesh_t) :: ring
   type(model_t) :: model
   type(assembly_t) :: asm
   type(contact_t) :: c
@@ -41,14 +39,7 @@ program test_schur
   integer :: i, nb, added, analyses, kept, made
 
   call mpi_start()
-  call mesh_ring(1._dp, 0.2_dp, 20, 1, ring, err)
-  if (allocated(err)) error stop 'mesh'
-  call model_add_body(model, 'ring1', ring, 210e9_dp, 0.3_dp, 7700._dp, 0.05_dp)
-  ring%x(1, :) = ring%x(1, :) + 1.9_dp   ! overlap 0.1 m on a line at 0.4 m from the axis
-  ring%x(2, :) = ring%x(2, :) + 0.4_dp
-  call model_add_body(model, 'ring2', ring, 210e9_dp, 0.3_dp, 7700._dp, 0.05_dp)
-  call model_finalize(model, err)
-  if (allocated(err)) error stop 'model'
+  call overlapping_rings(model)
   call assembly_setup(model, asm, err)
   allocate (q(model%ndof), r(model%ndof))
   call reference_state(model, q)

@@ -73,11 +73,5 @@ done
 
 if [ -n "$OLD" ]; then
   echo "== thesis decks, 1 rank: old default (OLD build) then 'auto' (new), interleaved"
-  for deck in two_rings three_rings; do
-    for r in $(seq "$REP"); do
-      o=$( { /usr/bin/time -f %e "$OLD/casca" run "$ROOT/examples/$deck.nml" --out "$T/o" -q >/dev/null; } 2>&1 | tail -1)
-      n=$( { /usr/bin/time -f %e "$NEW/casca" run "$ROOT/examples/$deck.nml" --out "$T/n" -q >/dev/null; } 2>&1 | tail -1)
-      echo "   $deck $r: old $o s, new $n s, new/old $(python3 -c "print(round($n / $o, 3))")"
-    done
-  done
+  bash "$ROOT/tests/bench/bench_frictionless.sh" "$OLD/casca" "$ROOT/examples" "$NEW/casca" "$ROOT/examples" "$REP"
 fi
