@@ -40,7 +40,9 @@ module casca_linear_system
     logical :: schur = .true.                  !< constraints through the Schur complement
     logical :: auto = .false.                  !< schur chosen at each iteration (casca_solver_choice)
     type(solver_choice_t) :: choice
-    logical :: refactored = .false.            !< K factorised since the last choice
+    logical :: refactored = .false.            !< K factorised since the last choice, not
+                                               !< because the pattern was analysed anew
+    logical :: analysed = .false.              !< analysed in this iteration
     type(schur_t) :: cache                     !< Z and S of the Schur path
     integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
     type(mass_solver_t) :: mass                !< M by component, for the contact correction
@@ -104,6 +106,7 @@ contains
       analyses = analyses + 1
     end do
     ls%last_irn = cirn; ls%last_jcn = cjcn
+    ls%analysed = .not. same
     call share_error(err)
   end subroutine analyse_blocks
 
@@ -129,7 +132,7 @@ contains
     end do
     call share_error(err)
     ls%cache%current = .false.   ! Z was made with the old factors
-    ls%refactored = .true.
+    ls%refactored = .not. ls%analysed   ! (a new pattern's factorisation is the analysis' cost)
   end subroutine factorise_blocks
 
   !> xx = K^-1 bb block by block (rows: this rank's equations, then, with 'saddle', the

@@ -37,31 +37,40 @@ contains
 
   !> For each row of the new set, the cached column it can keep (0: a new column is needed)
   !> while the factors of K are those the cache was made with: a row of the same key and
-  !> pattern; exact where its values are the same too (match_rows)
+  !> pattern; exact where its values are the same too (match_rows). The rows hold each
+  !> rank's own equations, so the ranks' verdicts are pooled: all keep a column, or none.
   subroutine schur_match(c, irn, jcn, val, fval, key, col, exact)
     type(schur_t), intent(in) :: c
     integer, intent(in) :: irn(:), jcn(:), key(:, :)
     real(dp), intent(in) :: val(:), fval(:)
     integer, intent(out) :: col(:)
     logical, intent(out) :: exact(:)
+    logical, allocatable :: same(:)
+    real(dp), allocatable :: differ(:, :)
     col = 0; exact = .false.
-    if (c%current .and. allocated(c%key)) &
-      call match_rows(c%irn, c%jcn, c%val, c%fval, c%key, irn, jcn, val, fval, key, col, exact)
+    if (.not. (c%current .and. allocated(c%key))) return
+    allocate (same(size(col)))
+    call match_rows(c%irn, c%jcn, c%val, c%fval, c%key, irn, jcn, val, fval, key, col, same, exact)
+    differ = reshape([merge(0._dp, 1._dp, same), merge(0._dp, 1._dp, exact)], [size(col), 2])
+    call sum_all(differ)
+    where (differ(:, 1) > 0) col = 0
+    exact = col > 0 .and. differ(:, 2) == 0
   end subroutine schur_match
 
   !> For each new row (entries irn, jcn, val, fval in row order, rows after the equations,
-  !> each ending with its diagonal; key), the old row of the same key and pattern (0: none),
-  !> and whether its values are the same too, bit for bit (exact). Rows mostly keep their
-  !> order, so the row after the last one matched is tried first.
-  pure subroutine match_rows(oirn, ojcn, oval, ofval, okey, irn, jcn, val, fval, key, col, exact)
+  !> each ending with its diagonal; key), the old row of the same key (0: none; keys are
+  !> replicated, so every rank picks the same), whether its pattern is the same (same) and
+  !> its values too, bit for bit (exact). Rows mostly keep their order, so the row after the
+  !> last one matched is tried first.
+  pure subroutine match_rows(oirn, ojcn, oval, ofval, okey, irn, jcn, val, fval, key, col, same, exact)
     integer, intent(in) :: oirn(:), ojcn(:), okey(:, :), irn(:), jcn(:), key(:, :)
     real(dp), intent(in) :: oval(:), ofval(:), val(:), fval(:)
     integer, intent(out) :: col(:)
-    logical, intent(out) :: exact(:)
+    logical, intent(out) :: same(:), exact(:)
     integer, allocatable :: first(:), ofirst(:)
     logical, allocatable :: taken(:)
     integer :: k, j, guess, nold
-    col = 0; exact = .false.
+    col = 0; same = .false.; exact = .false.
     nold = size(okey, 2)
     allocate (taken(nold))
     taken = .false.
@@ -70,38 +79,39 @@ contains
     guess = 1
     do k = 1, size(key, 2)
       if (guess <= nold) then
-        if (same_row(k, guess)) col(k) = guess
+        if (free_key(k, guess)) col(k) = guess
       end if
       if (col(k) == 0) then
         do j = 1, nold
-          if (same_row(k, j)) then
+          if (free_key(k, j)) then
             col(k) = j; exit
           end if
         end do
       end if
       if (col(k) > 0) then
         taken(col(k)) = .true.; guess = col(k) + 1
-        exact(k) = same_values(k, col(k))
+        call compare(k, col(k), same(k), exact(k))
       end if
     end do
   contains
-    pure logical function same_row(k, j)
+    pure logical function free_key(k, j)
       integer, intent(in) :: k, j
-      integer :: a, b, n
-      same_row = .false.
-      if (taken(j) .or. any(key(:, k) /= okey(:, j))) return
-      a = first(k); b = ofirst(j); n = first(k + 1) - a - 1   ! (the last, the row's diagonal,
-      if (ofirst(j + 1) - b - 1 /= n) return                 ! is numbered by its place)
-      same_row = all(jcn(a:a + n - 1) == ojcn(b:b + n - 1))
-    end function same_row
+      free_key = .not. taken(j) .and. all(key(:, k) == okey(:, j))
+    end function free_key
 
-    pure logical function same_values(k, j)
+    !> same: the entries on the same equations (the last, the row's diagonal, is numbered by
+    !> its place); exact: with the same values too
+    pure subroutine compare(k, j, same_k, exact_k)
       integer, intent(in) :: k, j
+      logical, intent(out) :: same_k, exact_k
       integer :: a, b, n
       a = first(k); b = ofirst(j); n = first(k + 1) - a
-      same_values = all(val(a:a + n - 1) == oval(b:b + n - 1)) .and. &
-                    all(fval(a:a + n - 1) == ofval(b:b + n - 1))
-    end function same_values
+      same_k = .false.; exact_k = .false.
+      if (ofirst(j + 1) - b /= n) return
+      same_k = all(jcn(a:a + n - 2) == ojcn(b:b + n - 2))
+      exact_k = same_k .and. all(val(a:a + n - 1) == oval(b:b + n - 1)) .and. &
+                 all(fval(a:a + n - 1) == ofval(b:b + n - 1))
+    end subroutine compare
   end subroutine match_rows
 
   !> Keep the new rows and Z: column k is the cached column col(k), or, where col(k) = 0,
