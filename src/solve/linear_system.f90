@@ -176,6 +176,7 @@ contains
     real(dp), allocatable :: bb(:, :), yy(:, :)
     integer, allocatable :: col(:), slot(:)
     logical, allocatable :: exact(:)
+    logical :: as_kept
     integer :: nc, e, k
     nc = size(rows%gap)
     if (.not. ls%schur .or. nc == 0) then
@@ -187,7 +188,9 @@ contains
     allocate (col(nc), slot(nc), exact(nc))
     call schur_match(ls%cache, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, col, exact)
     if (renew) where (.not. exact) col = 0
-    if (all(col == [(k, k=1, nc)]) .and. size(ls%cache%key, 2) == nc) then   ! Z and S as kept
+    as_kept = all(col == [(k, k=1, nc)])   ! (then the cache is allocated)
+    if (as_kept) as_kept = size(ls%cache%key, 2) == nc
+    if (as_kept) then   ! Z and S as kept
       allocate (yy(asm%neq, 1))
       call solve_blocks(ls, asm, reshape(b(1:asm%neq), [asm%neq, 1]), yy, 0, err)
       if (allocated(err)) return
