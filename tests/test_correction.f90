@@ -11,9 +11,7 @@
 program test_correction
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_mesh, only: mesh_t
-  use casca_mesh_generators, only: mesh_ring
-  use casca_model, only: model_t, model_add_body, model_finalize, dof, reference_state
+  use casca_model, only: model_t, dof, reference_state
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_newmark, only: state_t
   use casca_accounting, only: balance_t, account
@@ -24,10 +22,10 @@ program test_correction
   use casca_contact_correction, only: contact_correction
   use casca_vectors, only: cross
   use casca_mpi, only: mpi_start, mpi_stop
+  use casca_test_rings, only: overlapping_rings
   use casca_check, only: check_le, check_true, check_summary
   implicit none
 
-  type(mesh_t) :: ring
   type(model_t) :: model
   type(assembly_t) :: asm
   type(contact_t) :: c
@@ -40,14 +38,7 @@ program test_correction
   integer :: i, k, added
 
   call mpi_start()
-  call mesh_ring(1._dp, 0.2_dp, 20, 1, ring, err)
-  if (allocated(err)) error stop 'mesh'
-  call model_add_body(model, 'ring1', ring, 210e9_dp, 0.3_dp, 7700._dp, 0.05_dp)
-  ring%x(1, :) = ring%x(1, :) + 1.9_dp   ! overlap 0.1 m on a line at 0.4 m from the axis
-  ring%x(2, :) = ring%x(2, :) + 0.4_dp
-  call model_add_body(model, 'ring2', ring, 210e9_dp, 0.3_dp, 7700._dp, 0.05_dp)
-  call model_finalize(model, err)
-  if (allocated(err)) error stop 'model'
+  call overlapping_rings(model)
   call assembly_setup(model, asm, err)
   call mass_setup(model, ms, err)
   if (allocated(err)) error stop 'mass'

@@ -472,7 +472,8 @@ contains
     allocate (r%contact)
     call scene_contact(r%deck, r%model, r%contact, use_contact)
     if (.not. use_contact) deallocate (r%contact)
-    r%ls%schur = .not. use_contact .or. r%deck%contact%solver == 'schur'
+    r%ls%schur = .not. use_contact .or. r%deck%contact%solver /= 'saddle'
+    r%ls%auto = use_contact .and. r%deck%contact%solver == 'auto'
     if (use_contact .and. r%deck%run%analysis /= 'static') call mass_setup(r%model, r%ls%mass, r%err)
   end subroutine setup_contact
 

@@ -107,7 +107,7 @@ module casca_deck
     integer :: npairs = 0                       !< 0: every pair of bodies
     character(len=64) :: pairs(2, max_pairs) = ''
     real(dp) :: tolerance = 1e-7_dp             !< penetration accepted, relative to scene size
-    character(len=16) :: solver = 'schur'       !< 'schur' or 'saddle' (docs/method.md)
+    character(len=16) :: solver = 'auto'        !< 'auto', 'schur' or 'saddle' (docs/method.md)
     character(len=16) :: normal = 'nodal'       !< 'nodal' or 'element' (docs/method.md)
     character(len=16) :: surface = 'faces'      !< 'faces' (thickness offset) or 'mid'
     integer :: passes = 1                       !< 2: each body of a pair impacts the other too

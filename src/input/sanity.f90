@@ -200,8 +200,8 @@ contains
       end do
     end do
     call positive(deck%contact%line, '&contact: tolerance', deck%contact%tolerance)
-    if (deck%contact%solver /= 'schur' .and. deck%contact%solver /= 'saddle') &
-      call add_problem(deck, deck%contact%line, '&contact: solver must be ''schur'' or ''saddle''')
+    if (deck%contact%solver /= 'schur' .and. deck%contact%solver /= 'saddle' .and. deck%contact%solver /= 'auto') &
+      call add_problem(deck, deck%contact%line, '&contact: solver must be ''auto'', ''schur'' or ''saddle''')
     if (deck%contact%normal /= 'nodal' .and. deck%contact%normal /= 'element') &
       call add_problem(deck, deck%contact%line, '&contact: normal must be ''nodal'' or ''element''')
     if (deck%contact%surface /= 'faces' .and. deck%contact%surface /= 'mid') &

@@ -3,7 +3,8 @@
 !>     [ K  C^T ] [ dq      ]   [ b ]
 !>     [ C  0   ] [ dlambda ] = [ c ]
 !> solved either through the Schur complement of K ('schur': K's pattern never changes; the
-!> cache of casca_schur keeps Z = K^-1 C^T and S = C Z while the rows and K's factors stay)
+!> cache of casca_schur keeps each column of Z = K^-1 C^T, and S = C Z, while its row and
+!> K's factors stay)
 !> or by factorising the whole matrix ('saddle': one block, re-analysed whenever the
 !> constraint pattern changes).
 module casca_linear_system
@@ -12,7 +13,8 @@ module casca_linear_system
   use casca_model, only: model_t
   use casca_assembly, only: assembly_t, nblocks
   use casca_mumps_solver, only: sparse_solver_t
-  use casca_schur, only: schur_t, schur_valid, schur_store, schur_apply
+  use casca_schur, only: schur_t, schur_match, schur_store, schur_apply
+  use casca_solver_choice, only: solver_choice_t, choose_solver
   use casca_mass_solver, only: mass_solver_t
   use casca_metis, only: nested_dissection
   use casca_mpi, only: sum_all, share_error
@@ -36,6 +38,11 @@ module casca_linear_system
   type :: linear_system_t
     type(sparse_solver_t) :: solver(nblocks)   !< one per block of K (casca_assembly)
     logical :: schur = .true.                  !< constraints through the Schur complement
+    logical :: auto = .false.                  !< schur chosen at each iteration (casca_solver_choice)
+    type(solver_choice_t) :: choice
+    logical :: refactored = .false.            !< K factorised since the last choice, not
+                                               !< because the pattern was analysed anew
+    logical :: analysed = .false.              !< analysed in this iteration
     type(schur_t) :: cache                     !< Z and S of the Schur path
     integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
     type(mass_solver_t) :: mass                !< M by component, for the contact correction
@@ -49,6 +56,7 @@ contains
 
   !> Symbolic analysis of each block at its first solve and, with 'saddle', whenever the
   !> constraint pattern in the matrix changes (its one block has the rows after K's equations).
+  !> With auto, the path is chosen first (a change of path is a change of pattern).
   subroutine analyse_blocks(ls, model, asm, rows, analyses, err)
     type(linear_system_t), intent(inout) :: ls
     type(model_t), intent(in) :: model
@@ -60,6 +68,11 @@ contains
     integer, allocatable :: perm(:), irn(:), jcn(:), cirn(:), cjcn(:)
     integer :: nf, n, off, s, i
     logical :: same
+    if (ls%auto) then
+      call choose_solver(ls%choice, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, ls%refactored, &
+                         asm%ngroups == 1, ls%schur)
+      ls%refactored = .false.
+    end if
     if (ls%schur) then   ! the constraints stay out of the factorised matrix
       allocate (cirn(0), cjcn(0))
     else
@@ -93,6 +106,7 @@ contains
       analyses = analyses + 1
     end do
     ls%last_irn = cirn; ls%last_jcn = cjcn
+    ls%analysed = .not. same
     call share_error(err)
   end subroutine analyse_blocks
 
@@ -118,6 +132,7 @@ contains
     end do
     call share_error(err)
     ls%cache%current = .false.   ! Z was made with the old factors
+    ls%refactored = .not. ls%analysed   ! (a new pattern's factorisation is the analysis' cost)
   end subroutine factorise_blocks
 
   !> xx = K^-1 bb block by block (rows: this rank's equations, then, with 'saddle', the
@@ -146,7 +161,10 @@ contains
 
   !> The saddle-point solve: b (asm%neq + nc) holds K's right-hand side then -gap; x the
   !> increment of this rank's equations then dlambda (replicated with 'schur'; on the host
-  !> of block 1 with 'saddle'). With 'schur', the kept Z and S serve unless renew.
+  !> of block 1 with 'saddle'). With 'schur', the columns of Z made with K's factors in use
+  !> are kept for the rows of the same key (casca_schur) and only the new rows' are solved
+  !> for, with b, in one call; renew: a kept row whose values changed since (the contact
+  !> point projected again) is made anew too, as when Newton contracts slowly.
   subroutine kkt_solve(ls, asm, rows, b, renew, x, err)
     type(linear_system_t), intent(inout) :: ls
     type(assembly_t), intent(in) :: asm
@@ -156,7 +174,10 @@ contains
     real(dp), intent(out) :: x(:)
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: bb(:, :), yy(:, :)
-    integer :: nc, e
+    integer, allocatable :: col(:), slot(:)
+    logical, allocatable :: exact(:)
+    logical :: as_kept
+    integer :: nc, e, k
     nc = size(rows%gap)
     if (.not. ls%schur .or. nc == 0) then
       allocate (yy(size(b), 1))
@@ -164,21 +185,29 @@ contains
       x = yy(:, 1)
       return
     end if
-    if (renew .or. .not. schur_valid(ls%cache, rows%key)) then   ! Z: nc + 1 right-hand sides
-      allocate (bb(asm%neq, nc + 1), yy(asm%neq, nc + 1))
+    allocate (col(nc), slot(nc), exact(nc))
+    call schur_match(ls%cache, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, col, exact)
+    if (renew) where (.not. exact) col = 0
+    as_kept = all(col == [(k, k=1, nc)])   ! (then the cache is allocated)
+    if (as_kept) as_kept = size(ls%cache%key, 2) == nc
+    if (as_kept) then   ! Z and S as kept
+      allocate (yy(asm%neq, 1))
+      call solve_blocks(ls, asm, reshape(b(1:asm%neq), [asm%neq, 1]), yy, 0, err)
+      if (allocated(err)) return
+    else            ! b and the new rows' columns B^T, in one solve
+      slot = 0
+      slot(pack([(k, k=1, nc)], col == 0)) = [(1 + k, k=1, count(col == 0))]
+      allocate (bb(asm%neq, 1 + count(col == 0)), yy(asm%neq, 1 + count(col == 0)))
       bb = 0
       bb(:, 1) = b(1:asm%neq)
       do e = 1, size(rows%irn)
-        if (rows%irn(e) /= rows%jcn(e)) bb(rows%jcn(e), 1 + rows%irn(e) - asm%neq) = rows%fval(e)
+        k = rows%irn(e) - asm%neq
+        if (rows%irn(e) /= rows%jcn(e) .and. slot(k) > 0) bb(rows%jcn(e), slot(k)) = rows%fval(e)
       end do
       call solve_blocks(ls, asm, bb, yy, 0, err)
       if (allocated(err)) return
-      call schur_store(ls%cache, asm%neq, rows%irn, rows%jcn, rows%val, rows%key, yy(:, 2:), err, &
-                       any(rows%fval /= rows%val))
-      if (allocated(err)) return
-    else                    ! the kept Z and S: one right-hand side
-      allocate (yy(asm%neq, 1))
-      call solve_blocks(ls, asm, reshape(b(1:asm%neq), [asm%neq, 1]), yy, 0, err)
+      call schur_store(ls%cache, asm%neq, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, col, &
+                       yy(:, 2:), err)
       if (allocated(err)) return
     end if
     call schur_apply(ls%cache, asm%neq, yy(:, 1), rows%gap, x)
@@ -209,14 +238,20 @@ contains
     call self%mass%finish()
   end subroutine system_finish
 
-  !> The next solve refactorises (a restart from a checkpoint takes the same path).
+  !> The next solve refactorises and auto chooses afresh (a restart from a checkpoint takes
+  !> the same path).
   subroutine system_drop_factors(self)
     class(linear_system_t), intent(inout) :: self
+    type(solver_choice_t) :: fresh
     integer :: s
     do s = 1, nblocks
       call self%solver(s)%drop_factors()
     end do
     self%cache%current = .false.
+    if (self%auto) then
+      self%choice = fresh
+      self%schur = .true.
+    end if
   end subroutine system_drop_factors
 
   !> The unknowns changed: the next solve analyses again.
