@@ -25,6 +25,10 @@ cantilever   a steel strip 1 m x 0.1 m, h 10 mm, poisson 0, clamped at x = 0, un
              deflection) is the Euler-Bernoulli first period 2 pi / (1.8751^2 sqrt(E h^2 /
              (12 rho L^4))) = 0.11969 s within 1%, and the largest tip deflection is twice the
              static q L^4 / (8 E I) within 3% (a sudden load; the higher modes add about 1%).
+restart      the adaptive rings to 10 ms with checkpoints every 5 ms, and the same deck cut at
+             5 ms restarted from its checkpoint into a new folder: the restarted history
+             equals the uninterrupted one (same steps, every column within 1e-12 of its
+             largest value): the checkpoint carries the next step's length.
 deck         rho_inf given with beta is refused (exit 2, the message names &run, rho_inf and
              beta); rho_inf = 1.5 and tolerance = -1 are refused naming the field.
 """
@@ -114,6 +118,36 @@ if out is not None:
     if tc.size >= 2:
         ck.close("cantilever: period [s] vs Euler-Bernoulli", tc[1] - tc[0], period, 0.01)
     ck.close("cantilever: largest tip deflection [m] vs 2 q L^4 / (8 E I)", -np.min(z), 2 * static, 0.03)
+
+
+def rings_adaptive(name, t_end):
+    path = os.path.join(work, name + ".nml")
+    with open(path, "w") as f:
+        f.write(f"""&run dt = 5e-5, t_end = {t_end}, rho_inf = 0.8, tolerance = 1e-4 /
+&output interval = 1e-3, vtu = .false., plots = .false., checkpoint_interval = 5e-3 /
+&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0, {STEEL}, thickness = {H} /
+&body name = 'ring2', mesh = 'file', file = '{ring}', center = 2.0137, 0.0, 0.0, {STEEL}, thickness = {H} /
+&contact surface = 'mid', pairs = 'ring1', 'ring2' /
+""")
+    return path
+
+
+full = rings_adaptive("restart_full", 0.01)
+half = rings_adaptive("restart_half", 0.005)
+p1 = run([casca, "run", full, "-q", "--out", os.path.join(work, "restart_full")])
+p2 = run([casca, "run", half, "-q", "--out", os.path.join(work, "restart_half")])
+p3 = run([casca, "run", full, "-q", "--out", os.path.join(work, "restarted"),
+          "--restart", os.path.join(work, "restart_half", "checkpoint.h5")])
+ck.record("restart: the three runs end with exit 0", p1.returncode == p2.returncode == p3.returncode == 0,
+          (p1.stderr + p2.stderr + p3.stderr)[-300:])
+if p1.returncode == p2.returncode == p3.returncode == 0:
+    a = history(os.path.join(work, "restart_full"))
+    b = history(os.path.join(work, "restarted"))
+    ck.record("restart: the same steps as the uninterrupted run", len(a["t"]) == len(b["t"]),
+              "%d and %d rows" % (len(a["t"]), len(b["t"])))
+    if len(a["t"]) == len(b["t"]):
+        worst = max(np.max(np.abs(a[c] - b[c])) / max(np.max(np.abs(a[c])), 1e-300) for c in a)
+        ck.le("restart: largest difference of a column over its largest value", worst, 1e-12)
 
 
 def refused(name, run_line, words):

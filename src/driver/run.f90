@@ -226,7 +226,8 @@ contains
       call reference_state(model, r%q0)
       if (r%restart /= '') then   ! (statics: t is the load factor, <= 1)
         call load_checkpoint(r%restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
-                             'static'), deck%run%max_step_cuts, r%st, r%level, r%err, r%contact)
+                             'static'), deck%run%max_step_cuts, r%st, r%level, r%err, r%contact, &
+                             r%dt_try)
         if (failed(r, 'restart')) return
         r%restart_step = r%st%step
       end if
@@ -609,7 +610,8 @@ contains
     type(error_t), allocatable :: e
     call r%ls%drop_factors()   ! on every rank: a restart from here starts with new factors
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
-    if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e)
+    if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e, &
+                                                  r%dt_try)
     call share_error(e)
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message

@@ -53,13 +53,14 @@ contains
 
   !> Write the checkpoint path (rank 0; the caller shares err): refused if the state or the
   !> multipliers are not finite.
-  subroutine save_checkpoint(path, model, st, level, contact, err)
+  subroutine save_checkpoint(path, model, st, level, contact, err, dt_next)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
     integer, intent(in) :: level
     type(contact_t), intent(in), optional :: contact
     type(error_t), allocatable, intent(out) :: err
+    real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)
     integer :: k, nact
     if (.not. is_root()) return
     nact = 0
@@ -92,17 +93,17 @@ contains
                              (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
                               k=1, nact), contact%friction_work, contact%obstacle_work, &
                              contact%impulse, contact%carry], err, &
-                            model_fingerprint(model))
+                            model_fingerprint(model), dt_next)
     else
       call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, [level, 0], &
-                            [real(dp) ::], err, model_fingerprint(model))
+                            [real(dp) ::], err, model_fingerprint(model), dt_next)
     end if
   end subroutine save_checkpoint
 
   !> Read the checkpoint path into st, level and the contact active set, after checking that
   !> it belongs to this model and that every field is in range: 0 <= t <= t_max, step >= 0,
   !> 0 <= level <= max_level, each constraint an impactor node of one of the contact pairs.
-  subroutine load_checkpoint(path, model, t_max, max_level, st, level, err, contact)
+  subroutine load_checkpoint(path, model, t_max, max_level, st, level, err, contact, dt_next)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: t_max
@@ -111,13 +112,14 @@ contains
     integer, intent(out) :: level
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
+    real(dp), intent(out), optional :: dt_next   !< 0: not in the checkpoint
     integer, allocatable :: ints(:), fp(:)
     real(dp), allocatable :: reals(:)
     integer :: k, nact, node, pair, per
     character(len=:), allocatable :: bad
 
     level = 0
-    call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp)
+    call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next)
     if (allocated(err)) return
     bad = ''
     if (.not. allocated(fp)) then
@@ -138,6 +140,9 @@ contains
     else if (ints(1) < 0 .or. ints(1) > max_level) then
       bad = 'its step-cut level '//itoa(ints(1))//' is outside [0, max_step_cuts = '// &
             itoa(max_level)//']'
+    end if
+    if (bad == '' .and. present(dt_next)) then
+      if (.not. (dt_next >= 0 .and. dt_next <= t_max)) bad = 'its next step is outside [0, t_end]'
     end if
     if (bad == '') then
       level = ints(1); nact = ints(2)
