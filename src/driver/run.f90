@@ -415,11 +415,8 @@ contains
     same = .true.
     if (present(contact_before)) same = same_active_set(contact_before, r%contact)
     ok = err <= 1 .or. h <= r%sc%dt_min .or. .not. same
-    if (ok .and. ratio >= 1 .and. h < r%dt_try) then
-      continue   ! (a step ended early by a frame or a contact: dt_try stands)
-    else
-      r%dt_try = max(h*ratio, r%sc%dt_min)
-    end if
+    ! (a step ended early by a frame or a contact, within the tolerance: dt_try stands)
+    if (.not. (ok .and. ratio >= 1 .and. h < r%dt_try)) r%dt_try = max(h*ratio, r%sc%dt_min)
     ! past an onset the contact sets the pace: the deck's dt, grown as the error allows
     if (r%landing .or. .not. same) r%dt_try = min(r%dt_try, r%deck%run%dt)
   end function step_accepted

@@ -1,7 +1,7 @@
-!> The length of the next step of a run: fixed (the deck's dt, halved after a failed step and
-!> grown back when Newton is at ease) or chosen by the error estimate (&run tolerance,
-!> casca_step_control), ended at output frames and at the predicted time of first contact so
-!> that neither is stepped over.
+!> What the error-controlled step (casca_run's step_length and step_accepted) asks of the
+!> contact: the predicted time of first contact, at which a step is ended so that the onset
+!> is not stepped over, and whether a step changed the active set (such a step is not taken
+!> again for its error).
 module casca_step_size
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
