@@ -22,6 +22,10 @@ module casca_contact
     integer :: elem = 0         !< target element; 0: an obstacle, or not projected yet (restart)
     integer :: side = 0         !< side of a two-sided target the node is on (+-1), 0: not known
     real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
+    !> where the force acts on the target (projection.f90, force_point): its face's point on
+    !> the node's line along n at the configuration the internal force is taken at; the rows
+    !> of C keep xi and shp, which define the gap
+    real(dp) :: xif(2) = 0, shpf(10) = 0
     real(dp) :: gap = 0, lambda = 0
     real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)
     !> the gap's derivative on the fibres: wg(1) n.dG at the node, wg(2) sum_j N_j n.dG_j

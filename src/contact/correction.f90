@@ -102,7 +102,7 @@ contains
       real(dp), intent(in) :: y(:)
       integer :: nd, d(max_row)
       real(dp) :: w(max_row)
-      call constraint_row(c%act(rk(r)), model, d, w, nd, rkind(r))
+      call constraint_row(c%act(rk(r)), model, d, w, nd, rkind(r), force=.true.)
       row_dot = dot_product(w(1:nd), y(d(1:nd)))
     end function row_dot
 
@@ -215,7 +215,7 @@ contains
     real(dp) :: w(max_row)
     b = 0
     do col = 1, size(rk)
-      call constraint_row(cons(rk(col)), model, d, w, nd, rkind(col))
+      call constraint_row(cons(rk(col)), model, d, w, nd, rkind(col), force=.true.)
       do j = 1, nd
         if (mod(mod(d(j) - 1, ndof_node), 3) + 1 /= comp) cycle   ! (Y_comp or G_comp)
         e = ms%eq(d(j))

@@ -23,7 +23,8 @@ module casca_contact_projection
   use casca_contact, only: contact_t, constraint_t, search_radius
   implicit none
   private
-  public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face
+  public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face, &
+            force_point
 
   integer, parameter, public :: max_row = 66   !< 11 nodes x (Y, G)
 
@@ -107,6 +108,7 @@ contains
       if (c%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
                              -con%n, con%face(1), con%off, con%wg(1))
       con%gap = gm - con%off
+      call hold_force_point()
       call friction_geometry()
       return
     end if
@@ -153,8 +155,14 @@ contains
       con%wg(2) = -con%wg(2)
     end if
     con%gap = con%side*gm - con%off
+    call hold_force_point()
     call friction_geometry()
   contains
+    !> the force acts at the gap's point until force_point finds its own
+    subroutine hold_force_point()
+      con%xif = con%xi; con%shpf = con%shp
+    end subroutine hold_force_point
+
     !> tangents (the first kept from the last, turned across n) and the relative tangential
     !> displacement of the node over the step
     subroutine friction_geometry()
@@ -208,40 +216,50 @@ contains
   end subroutine face
 
   !> The nodes a constraint acts on and the weights of its row of C: n on the impactor node,
-  !> -N_j n on the target element's nodes (none for an obstacle). m: how many.
-  pure subroutine constraint_entries(con, model, nodes, w, m)
+  !> -N_j n on the target element's nodes (none for an obstacle). m: how many. force: at
+  !> the point where the force acts (shpf), else the gap's (shp).
+  pure subroutine constraint_entries(con, model, nodes, w, m, force)
     type(constraint_t), intent(in) :: con
     type(model_t), intent(in) :: model
     integer, intent(out) :: nodes(11), m
     real(dp), intent(out) :: w(11)
+    logical, intent(in), optional :: force
     nodes(1) = con%node; w(1) = 1
     m = 1
     if (con%elem == 0) return
     nodes(2:) = model%conn(:, con%elem); w(2:) = -con%shp
+    if (present(force)) then
+      if (force) w(2:) = -con%shpf
+    end if
     m = 11
   end subroutine constraint_entries
 
   !> Row of C of one constraint as parameters d(1:nd) and values v(1:nd). kind 0: the
   !> normal row, the mid-surface points along n and, between faces, the fibres that carry the
   !> offset; kind 1, 2: the stick rows along t1, t2; kind 3: along the slip direction s (the
-  !> sliding force's, mu_d |lambda| on it)
-  pure subroutine constraint_row(a, model, d, v, nd, kind)
+  !> sliding force's, mu_d |lambda| on it). force: the normal row as the force acts, at
+  !> shpf; the same parameters in the same order as the gap's row.
+  pure subroutine constraint_row(a, model, d, v, nd, kind, force)
     type(constraint_t), intent(in) :: a
     type(model_t), intent(in) :: model
     integer, intent(out) :: d(max_row), nd
     real(dp), intent(out) :: v(max_row)
     integer, intent(in), optional :: kind
+    logical, intent(in), optional :: force
     integer :: j, comp, nodes(11), nn, kd
     real(dp) :: w(11), wf, dir(3)
+    logical :: at_force
     kd = 0
     if (present(kind)) kd = kind
+    at_force = .false.
+    if (present(force)) at_force = force .and. kd == 0
     select case (kd)
     case (0); dir = a%n
     case (1, 2); dir = a%t(:, kd)
     case default; dir = a%s
     end select
     nd = 0
-    call constraint_entries(a, model, nodes, w, nn)
+    call constraint_entries(a, model, nodes, w, nn, at_force)
     do comp = 1, 3
       do j = 1, nn
         nd = nd + 1; d(nd) = dof(nodes(j), comp); v(nd) = w(j)*dir(comp)
@@ -249,13 +267,59 @@ contains
     end do
     if (kd /= 0 .or. all(a%wg == 0)) return
     do j = 1, nn
+      if (merge(a%wg(1), a%wg(2), j == 1) == 0) cycle   ! (so the pattern follows wg only)
       wf = merge(a%wg(1), -w(j)*a%wg(2), j == 1)   ! (-w(j) = N_j on the target)
-      if (wf == 0) cycle
       do comp = 1, 3
-        nd = nd + 1; d(nd) = dof(nodes(j), 3 + comp); v(nd) = wf*a%n(comp)
+        nd = nd + 1; d(nd) = dof(nodes(j), 3 + comp); v(nd) = wf*dir(comp)
       end do
     end do
   end subroutine constraint_row
+
+  !> Where con's force acts at configuration q (positions and fibres): the point xif of the
+  !> target's face, T(xi) = sum_j N_j (Y_j - wg(2) G_j), on the line through the node's face
+  !> point P = Y + wg(1) G along the gap's normal n: T(xif) + s n = P. The force pair,
+  !> -lambda n on P and lambda n on T, then lies on one line and has no moment: taken where
+  !> the scheme takes the internal force (the midpoint rule's q_mid), frictionless contact
+  !> keeps the free bodies' angular momentum. (The gap's own point, held through the step,
+  !> is half a step's slide away from the node there. The closest point of the face was
+  !> tried first: it keeps L as well, but at a node shared by curved elements it is not
+  !> unique, and pole-on-pole contact between spheres turned sideways.)
+  !> Newton on (xi, s) from the gap's point; the polynomial face holds beyond the element's
+  !> edge, so a point just outside is kept (its weights still sum to one); one not found
+  !> keeps the gap's point (an obstacle's too).
+  pure subroutine force_point(model, q, con)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    type(constraint_t), intent(inout) :: con
+    real(dp) :: ye(3, 10), p(3), xi(2), shp(10), dphi(10, 2), j(3, 3), f(3), dx(3), det
+    integer :: k, it, nd
+    con%xif = con%xi; con%shpf = con%shp
+    if (con%elem == 0) return
+    do k = 1, 10
+      nd = model%conn(k, con%elem)
+      ye(:, k) = q(dof(nd, 1):dof(nd, 3)) - con%wg(2)*q(dof(nd, 4):dof(nd, 6))
+    end do
+    p = q(dof(con%node, 1):dof(con%node, 3)) + con%wg(1)*q(dof(con%node, 4):dof(con%node, 6))
+    xi = con%xi
+    dx = 1
+    do it = 1, 20
+      call tri10_shape(xi(1), xi(2), shp, dphi)
+      j(:, 1:2) = matmul(ye, dphi); j(:, 3) = con%n
+      f = p - matmul(ye, shp)   ! = J [dxi; s] to first order (s enters linearly)
+      f = f - dot_product(f, con%n)*con%n   ! (s itself is not wanted: solve across n only)
+      det = dot_product(j(:, 1), cross(j(:, 2), j(:, 3)))
+      if (.not. abs(det) > 0) return
+      ! Cramer's rule for the two xi components of J [dxi; ds] = f
+      dx(1) = dot_product(f, cross(j(:, 2), j(:, 3)))/det
+      dx(2) = dot_product(j(:, 1), cross(f, j(:, 3)))/det
+      xi = xi + dx(1:2)
+      if (min(xi(1), xi(2), 1 - xi(1) - xi(2)) < -0.25_dp) return
+      if (maxval(abs(dx(1:2))) <= 1e-14_dp) exit
+    end do
+    if (maxval(abs(dx(1:2))) > 1e-12_dp) return
+    call tri10_shape(xi(1), xi(2), shp, dphi)
+    con%xif = xi; con%shpf = shp
+  end subroutine force_point
 
   !> Unit normal of the cubic surface with node positions xe where the shape derivatives are dphi
   pure function unit_normal(xe, dphi) result(n)

@@ -5,13 +5,13 @@ module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_contact, only: contact_t, constraint_t, stick, slip
-  use casca_contact_projection, only: constraint_entries, constraint_row, max_row
+  use casca_contact_projection, only: constraint_entries, constraint_row, max_row, force_point
   use casca_time_scheme, only: scheme_t
   implicit none
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
-  public :: constraint_nkinds, slip_force, add_step_impulse
+  public :: constraint_nkinds, slip_force, add_step_impulse, pair_forces, contact_force_points
 
 contains
 
@@ -27,6 +27,17 @@ contains
     integer :: k
     contact_nrows = sum([(constraint_nkinds(c%act(k)), k=1, c%nact)])
   end function contact_nrows
+
+  !> Every active constraint's force point at configuration q (force_point)
+  pure subroutine contact_force_points(c, model, q)
+    type(contact_t), intent(inout) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    integer :: k
+    do k = 1, c%nact
+      call force_point(model, q, c%act(k))
+    end do
+  end subroutine contact_force_points
 
   !> The multipliers of every row, in row order
   pure function contact_multipliers(c) result(lam)
@@ -56,8 +67,9 @@ contains
 
   !> Constraint rows for MUMPS: entries (neq + r, eq) of dg_r/dq (irn > jcn), a zero
   !> diagonal for each multiplier, the gaps, and each row's key (node and kind, element).
-  !> fval: the same entries of the columns the multipliers act through: C^T, but for a
-  !> sliding constraint's normal row n - mu_d s on its points (its friction follows |lambda|).
+  !> fval: the same entries of the columns the multipliers act through: C^T where the force
+  !> acts (force_point), and for a sliding constraint's normal row n - mu_d s on its points
+  !> (its friction follows |lambda|).
   subroutine contact_rows(c, model, eq, neq, irn, jcn, val, gap, key, fval)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
@@ -65,7 +77,7 @@ contains
     integer, allocatable, intent(out) :: irn(:), jcn(:), key(:, :)
     real(dp), allocatable, intent(out) :: val(:), gap(:), fval(:)
     integer :: k, j, m, nd, d(max_row), r, kind, nr, ns
-    real(dp) :: v(max_row), vs(max_row), mu
+    real(dp) :: v(max_row), vs(max_row), vf(max_row), mu
     nr = contact_nrows(c)
     allocate (irn((max_row + 1)*nr), jcn((max_row + 1)*nr), val((max_row + 1)*nr), gap(nr), key(2, nr), &
               fval((max_row + 1)*nr))
@@ -80,6 +92,7 @@ contains
         end if
         key(:, r) = [4*c%act(k)%node + kind, c%act(k)%elem]
         call constraint_row(c%act(k), model, d, v, nd, kind)
+        call constraint_row(c%act(k), model, d, vf, nd, kind, force=.true.)
         mu = 0; ns = 0
         if (kind == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
           mu = c%mu_d(c%act(k)%pair); key(1, r) = 4*c%act(k)%node + 3
@@ -87,8 +100,8 @@ contains
         end if
         do j = 1, nd
           if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
-          m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = v(j); fval(m) = v(j)
-          if (j <= ns) fval(m) = v(j) - mu*vs(j)
+          m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = v(j); fval(m) = vf(j)
+          if (j <= ns) fval(m) = vf(j) - mu*vs(j)
         end do
         m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
       end do
@@ -115,7 +128,7 @@ contains
     f = 0
     do k = 1, c%nact
       associate (a => c%act(k))
-        call constraint_row(a, model, d, v, nd)
+        call constraint_row(a, model, d, v, nd, force=.true.)
         f(d(1:nd)) = f(d(1:nd)) + a%lambda*v(1:nd)
         if (a%grip == stick) then
           call constraint_row(a, model, d, v, nd, 1)
@@ -147,20 +160,32 @@ contains
     end do
   end function contact_max_gap
 
+  !> The contact force on each pair's impactor (3, npairs): normal and friction
+  pure function pair_forces(c) result(f)
+    type(contact_t), intent(in) :: c
+    real(dp) :: f(3, c%npairs)
+    integer :: k
+    f = 0
+    do k = 1, c%nact
+      f(:, c%act(k)%pair) = f(:, c%act(k)%pair) + node_force(c, c%act(k))
+    end do
+  end function pair_forces
+
   !> After an accepted step (scheme ts): add each pair's impulse on its impactor as the
   !> integrator applied it, and the moving obstacles' work from it. The step changes the
   !> momentum by dt ((1 - gamma) A_start + gamma A_end) + C^T nu: A_start the contact's share
   !> of M a at the start (the last step's, with its acceleration corrections mu: c%carry),
   !> less the normal force of the constraints released taken out of it (newmark.f90);
-  !> A_end = (F_end - alpha_m A_start)/(1 - alpha_m) with F_end the end forces (Newmark:
-  !> A_end = F_end); nu the velocity correction's impulses, in row order. (dt F_end summed
-  !> over the steps is off by Newton's tolerance; this is exact.)
-  subroutine add_step_impulse(c, ts, released, nu)
+  !> A_end = (F_end - alpha_m A_start)/(1 - alpha_m) with F_end the end forces (pair_forces
+  !> as Newton left them: f_end); nu the velocity correction's impulses, in row order, along
+  !> the normals it took (Newmark: A_end = F_end). (dt F_end summed over the steps is off by
+  !> Newton's tolerance; this is exact.)
+  subroutine add_step_impulse(c, ts, released, nu, f_end)
     type(contact_t), intent(inout) :: c
     type(scheme_t), intent(in) :: ts
     type(constraint_t), intent(in) :: released(:)
-    real(dp), intent(in) :: nu(:)
-    real(dp) :: j(3, c%npairs), f_end(3, c%npairs), mu(3, c%npairs), dt, g
+    real(dp), intent(in) :: nu(:), f_end(:, :)
+    real(dp) :: j(3, c%npairs), a_end(3, c%npairs), mu(3, c%npairs), dt, g
     integer :: k, r, t
     dt = ts%dt; g = ts%gamma
     do k = 1, size(released)
@@ -168,11 +193,10 @@ contains
         c%carry(:, a%pair) = c%carry(:, a%pair) - (a%mu - a%lambda)*a%n
       end associate
     end do
-    j = 0; f_end = 0; mu = 0
+    j = 0; mu = 0
     r = 0
     do k = 1, c%nact
       associate (a => c%act(k))
-        f_end(:, a%pair) = f_end(:, a%pair) + node_force(c, a)
         j(:, a%pair) = j(:, a%pair) + nu(r + 1)*a%n
         mu(:, a%pair) = mu(:, a%pair) + a%mu*a%n
         if (a%grip == stick) then
@@ -182,9 +206,9 @@ contains
         r = r + constraint_nkinds(a)
       end associate
     end do
-    f_end = ts%end_force_weight(f_end, c%carry)
-    j = j + dt*((1 - g)*c%carry + g*f_end)
-    c%carry = f_end + mu
+    a_end = ts%end_force_weight(f_end, c%carry)
+    j = j + dt*((1 - g)*c%carry + g*a_end)
+    c%carry = a_end + mu
     c%impulse = c%impulse + j
     do k = 1, c%npairs
       t = c%pair(2, k)
@@ -213,7 +237,7 @@ contains
     do k = 1, c%nact
       associate (a => c%act(k))
         f = node_force(c, a)
-        call constraint_entries(a, model, nodes, w, nn)
+        call constraint_entries(a, model, nodes, w, nn, force=.true.)
         do j = 1, nn
           force(:, nodes(j)) = force(:, nodes(j)) + w(j)*f
         end do

@@ -415,8 +415,13 @@ contains
     same = .true.
     if (present(contact_before)) same = same_active_set(contact_before, r%contact)
     ok = err <= 1 .or. h <= r%sc%dt_min .or. .not. same
-    ! (a step ended early by a frame or a contact, within the tolerance: dt_try stands)
-    if (.not. (ok .and. ratio >= 1 .and. h < r%dt_try)) r%dt_try = max(h*ratio, r%sc%dt_min)
+    ! (a step ended early by a frame or a contact, within the tolerance, does not shorten
+    ! dt_try; it may lengthen it: steps made equal to a frame are all a little short)
+    if (ok .and. ratio >= 1) then
+      r%dt_try = max(r%dt_try, h*ratio)
+    else
+      r%dt_try = max(h*ratio, r%sc%dt_min)
+    end if
     ! past an onset the contact sets the pace: the deck's dt, grown as the error allows
     if (r%landing .or. .not. same) r%dt_try = min(r%dt_try, r%deck%run%dt)
   end function step_accepted

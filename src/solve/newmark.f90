@@ -12,7 +12,7 @@ module casca_newmark
   use casca_contact_correction, only: contact_correction, add_impulses
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
-  use casca_contact_rows, only: add_step_impulse, contact_nrows
+  use casca_contact_rows, only: add_step_impulse, contact_nrows, contact_force_points, pair_forces
   use casca_timers, only: timer_start, timer_stop, t_contact
   use casca_time_scheme, only: scheme_t
   implicit none
@@ -47,7 +47,7 @@ contains
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:)
+    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:), f_end(:, :)
     type(constraint_t), allocatable :: before(:), released(:)
     real(dp) :: dt, g
     integer :: k, iters
@@ -56,6 +56,7 @@ contains
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
     allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
+      if (nm%alpha_f > 0) call contact_force_points(contact, model, st%q)   ! (as the last step left them: restarts too)
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
       contact%x_start = positions(model, st%q); contact%dt = dt   ! (friction's slip)
@@ -90,7 +91,7 @@ contains
       end if
     end if
     if (present(contact)) then   ! (before friction turns its slip directions)
-      call add_step_impulse(contact, nm, released, nu)
+      call add_step_impulse(contact, nm, released, nu, f_end)
       call friction_step_done(contact)
     end if
     st%q = q; st%qd = qd; st%qdd = qdd
@@ -112,6 +113,11 @@ contains
       call nm%update(st%q, st%qd, a0, q, qd, qdd)
       if (present(contact)) then   ! (on failure the state is left as it was)
         call timer_start(t_contact)
+        ! the forces as they acted (at the internal force's configuration), then the
+        ! correction's impulses where the step ends
+        if (nm%alpha_f > 0) call contact_force_points(contact, model, (1 - nm%alpha_f)*q + nm%alpha_f*st%q)
+        f_end = pair_forces(contact)
+        if (nm%alpha_f > 0) call contact_force_points(contact, model, q)
         if (allocated(nu)) deallocate (nu)
         allocate (nu(contact_nrows(contact)))
         call contact_correction(ls%mass, contact, model, qd, qdd, err, nu)

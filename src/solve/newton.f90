@@ -27,7 +27,8 @@ module casca_newton
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_active_set, only: contact_update, contact_settle, contact_solve_start
   use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_nrows, &
-                                contact_multipliers, contact_set_multipliers, contact_max_gap
+                                contact_multipliers, contact_set_multipliers, contact_max_gap, &
+                                contact_force_points
   use casca_mpi, only: is_root, sum_all
   use casca_timers, only: timer_start, timer_stop, t_assembly, t_contact, t_analysis, t_factor, &
                           t_solve
@@ -164,6 +165,9 @@ contains
         call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
                             reproject=reproject)
         nc = contact_nrows(contact)
+        if (present(qn) .and. present(af)) then   ! (where the internal force is taken)
+          if (af > 0) call contact_force_points(contact, model, (1 - af)*q + af*qn)
+        end if
         call contact_rows(contact, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, &
                           rows%key, rows%fval)
         version = contact%changes
