@@ -38,6 +38,7 @@ module casca_mesh_indicator
   integer, parameter :: indicator_line_len = 256   !< a report line: a 64-character name and figures
   integer, parameter :: ng = 3   !< Gauss points per edge: |[R]|^2 of degree 4 exactly
   integer, parameter :: nr = 18  !< components of R: N and (6/h) M, 3x3 each
+  real(dp), parameter :: strain_floor = 1e-10_dp   !< below: no resultants to be relative to
 
 contains
 
@@ -228,8 +229,11 @@ contains
     do b = 1, model%nbody
       associate (e1 => model%body(b)%elem_first, e2 => model%body(b)%elem_last)
         rb = sum(rr(e1:e2)); ab = sum(area(e1:e2)); eb = sum(et2(e1:e2))
-        ! an unloaded body has no resultants to be relative to: its indicator stays 0
-        if (e2 < e1 .or. rb <= tiny(1._dp)*ab) cycle
+        ! R / (E h) is a strain (of the mid-surface, or of the faces by bending): a body whose
+        ! RMS strain is below 1e-10 is unloaded or moving rigidly, its resultants are round-off
+        ! and a figure relative to them would be noise of order 1: its indicator stays 0
+        if (e2 < e1) cycle
+        if (rb <= ab*(strain_floor*model%body(b)%young*model%body(b)%thickness)**2) cycle
         ind%rel(e1:e2) = sqrt(et2(e1:e2)/area(e1:e2)/(rb/ab))
         ind%body_worst(b) = e1 - 1 + maxloc(ind%rel(e1:e2), dim=1)
         ind%body_max(b) = ind%rel(ind%body_worst(b))
@@ -250,7 +254,7 @@ contains
       e = ind%body_worst(b)
       if (e == 0) then
         write (lines(b), '(a,a,a)') 'mesh indicator: ', model%body(b)%name, &
-          ' max 0 (no shared edges or no resultants), rms 0'
+          ' max 0 (no shared edges, or no strain above 1e-10), rms 0'
         cycle
       end if
       c = sum(model%x0(:, model%conn(1:3, e)), dim=2)/3
