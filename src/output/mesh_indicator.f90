@@ -11,8 +11,8 @@
 !>   rel_e   = eta_e / (sqrt(A_e) R_rms),   R_rms^2 = int_body |R|^2 dA / A_body
 !>   body figure: sqrt(sum_e eta_e^2 / int_body |R|^2 dA)
 !>
-!> (the brief's l_E |[R]|^2 per edge was a force^2 / length: not comparable with the body's
-!> norm, a force^2. Spread over the element's area A_e as here, eta_e estimates the L2 error of
+!> (weighting each edge's |[R]|^2 by its length l_E gives a force^2 / length: not comparable
+!> with the body's norm, a force^2. Spread over the element's area A_e as here, eta_e estimates the L2 error of
 !> the resultants over e, so the eta_e^2 sum to the body's error and rel_e is the element's RMS
 !> error in units of the body's RMS resultant, independent of the element's size.)
 !> Lengths and areas are the initial mid-surface's; |.| is the Frobenius norm.
@@ -96,9 +96,9 @@ contains
 
   !> R = [N, (6/h) M] at (xi1, xi2) of an element, by the thickness rule (zt, wt) on [-1, 1]
   !> through casca's output stress (shell_stress: the Cauchy stress at the point), projected on
-  !> the current tangent plane: the transverse shear forces are left out, as the brief's N and M
-  !> have them not, and they are one derivative less smooth, so their scatter from element to
-  !> element (docs/verification.md, stresses) would mask the membrane and bending jumps.
+  !> the current tangent plane: the transverse shear forces are left out, being one derivative
+  !> less smooth: their scatter from element to element (docs/verification.md, stresses) would
+  !> mask the membrane and bending jumps the indicator is about.
   !> The distance through the thickness is the initial one, h/2 xi3: both sides of an edge use
   !> the same definition, which is what the jump needs.
   pure function resultants(x0, v0, h, lam, mu, q, xi1, xi2, zt, wt) result(r)
@@ -179,7 +179,7 @@ contains
       f = nbr(j, e)
       if (f == 0) cycle
       do g = 1, ng
-        gf = g   ! the symmetric edge rule: the point at t is the neighbour's at 1 - t
+        gf = g   ! traversed the other way (the rule is symmetric), point g is its ng + 1 - g
         if (.not. same(j, e)) gf = ng + 1 - g
         jump2 = jump2 + ds(g, j, e)*sum((redge(:, g, j, e) - redge(:, gf, nedge(j, e), f))**2)
         length = length + ds(g, j, e)
