@@ -164,6 +164,9 @@ contains
         '  --restart FILE    continue from a checkpoint of the same model (DIR/checkpoint.h5)', &
         '  -q, --quiet       no progress lines and no closing summary (errors still shown)', &
         '  -h, --help        this text', &
+        'prints a progress line per frame and a closing summary: the time taken, (dynamics) what was', &
+        '  kept and the energy balance, and each body''s mesh indicator (where its mesh is coarsest,', &
+        '  and a relative error estimate of its stress resultants: docs/mesh_indicator.md)', &
         'writes in the output folder:', &
         '  run.pvd, frame_NNNNN.vtu    ParaView frames with their times', &
         '  history.dat, history.h5     one row per step: energies, momenta, contacts, tracked nodes', &

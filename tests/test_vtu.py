@@ -15,6 +15,7 @@ If the `vtk` Python module is importable, VTK's own vtkLagrangeTriangle evaluate
 Exits non-zero on any failure.
 """
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -97,6 +98,13 @@ def random_samples(n, rng):
 
 def check_vtu(path, scale, samples):
     name = os.path.basename(path)
+    # meshio finds each raw block's DataArray by its offset after rewriting the earlier ones'
+    # to base64 positions: the blocks must be appended in the reverse order of the header
+    # (vtu_writer.f90), so that a rewritten offset never shadows a later block's
+    header = open(path, "rb").read().split(b"<AppendedData")[0].decode()
+    offsets = [int(o) for o in re.findall(r'offset="(\d+)"', header)]
+    check(len(offsets) > 4 and offsets[-1] == 0 and offsets == sorted(offsets, reverse=True),
+          f"{name}: offsets fall down the header to 0 (blocks appended last to first): {offsets}")
     try:
         mesh = meshio.read(path)
     except Exception as exc:  # any reader failure is a test failure, not a crash

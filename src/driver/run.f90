@@ -18,8 +18,9 @@ module casca_run
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
-                          output_flush, output_release
+                          output_flush, output_release, output_indicator_lines
   use casca_vtu_writer, only: field_t, field
+  use casca_mesh_indicator, only: indicator_line_len
   use casca_contact, only: contact_t
   use casca_contact_active_set, only: contact_update
   use casca_contact_rows, only: contact_force_total, contact_nodal_fields
@@ -649,7 +650,9 @@ contains
   subroutine finish(r)
     type(run_t), intent(inout) :: r
     type(error_t), allocatable :: e
+    character(len=indicator_line_len), allocatable :: lines(:)
     logical :: missing
+    integer :: k
     call r%ls%finish()
     call output_close(r%out, e)
     call share_error(e)
@@ -674,6 +677,9 @@ contains
                                      any(model%pressure /= 0))   ! (issue 17)
         print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact))
       end if
+      ! the mesh indicator of the last state, per body (issue 18)
+      lines = output_indicator_lines(r%out, model, r%st)
+      print '(a)', (trim(lines(k)), k=1, size(lines))
     end associate
   end subroutine finish
   !> The energy balance's terms that the scene has: friction's, moving obstacles'

@@ -3,6 +3,8 @@
 !>   history.dat + history.h5     one row per step: energies, momenta, contacts, tracked nodes,
 !>                                energies per body, force and contacts per contact pair
 !>   tracked.txt                  a label per tracked node (for the plots)
+!> Each frame carries the mesh indicator per cell (casca_mesh_indicator); the last one computed
+!> is kept for the run's end report (output_indicator_lines).
 module casca_output
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
@@ -23,10 +25,11 @@ module casca_output
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder
+  use casca_mesh_indicator, only: indicator_t, mesh_indicator, indicator_lines, indicator_line_len
   implicit none
   private
   public :: output_t, output_open, output_history, output_frame, output_close, output_flush, &
-            output_release
+            output_release, output_indicator_lines
 
   type :: output_t
     character(len=:), allocatable :: dir
@@ -42,6 +45,8 @@ module casca_output
     logical :: moving = .false.         !< the work of moving obstacles too
     integer :: rows = 0
     logical :: locked = .false.         !< this run holds the folder's lock
+    type(indicator_t) :: ind            !< the mesh indicator of the last frame ...
+    integer :: ind_step = -1            !< ... and its step (-1: none yet)
   end type output_t
 
   integer, parameter :: max_line = 65536   !< longest history.dat line read back at a restart
@@ -345,19 +350,37 @@ contains
     end do
     body = reshape(real(model%elem_body, dp), [1, model%nelem])
     call stress_fields(model, st%q, cell_stress, point_stress)
+    call mesh_indicator(model, st%q, out%ind)
+    out%ind_step = st%step
     write (name, '(a,i5.5,a)') 'frame_', out%nframes, '.vtu'
     ! geometry in the current configuration: ParaView shows the deformed shells directly
     call write_vtu(out%dir//'/'//trim(name), x, model%conn, &
                    [field('displacement', u), field('velocity', v), field('fibre', g), &
                     field('thickness_param', a), extra, point_stress], &
                    [field('body', body), field('strain_energy', cell_energy(model, st%q)), &
-                    cell_stress], err)
+                    cell_stress, field('mesh_indicator', reshape(out%ind%rel, [1, model%nelem]), &
+                                       single=.true.)], err)
     if (allocated(err)) return
     out%nframes = out%nframes + 1
     out%files = [character(len=32) :: out%files, name]
     out%times = [out%times, st%t]
     call write_pvd(out%dir//'/run.pvd', out%files, out%times, err)
   end subroutine output_frame
+
+  !> The end report's lines of the mesh indicator (one per body) for the state st: the last
+  !> frame's when it was written at st's step, else computed now (vtu = .false., a restart
+  !> without frames), so a run computes it at its frames and at most once more. Rank 0.
+  function output_indicator_lines(out, model, st) result(lines)
+    type(output_t), intent(inout) :: out
+    type(model_t), intent(in) :: model
+    type(state_t), intent(in) :: st
+    character(len=indicator_line_len), allocatable :: lines(:)
+    if (out%ind_step /= st%step .or. .not. allocated(out%ind%rel)) then
+      call mesh_indicator(model, st%q, out%ind)
+      out%ind_step = st%step
+    end if
+    lines = indicator_lines(model, out%ind)
+  end function output_indicator_lines
 
   !> The stress fields of a frame. Per cell, at the centroid: von_mises (mid-surface),
   !> von_mises_top, von_mises_bottom and the Cauchy stress tensors stress_top, stress_mid,

@@ -5,6 +5,13 @@
 !> connectivity is written unpermuted. Array data goes in one AppendedData block, encoding "raw":
 !> each array is a UInt64 byte count followed by the values in native byte order (declared in
 !> byte_order), which is the smallest and fastest form ParaView reads, and meshio reads too.
+!> The arrays' blocks are appended in the reverse order of their DataArray lines (offsets
+!> fall down the header): meshio turns raw data into base64 by finding each block's DataArray
+!> by its offset attribute, block after block, after rewriting the earlier blocks' offsets to
+!> base64 positions, and takes the first match; in header order a rewritten offset that equals
+!> a later block's raw offset made it read the wrong array (a 10 x 1 strip's frame:
+!> von_mises_top rewritten to 25888, the raw offset of the cells' offsets). Reversed, the
+!> block it looks for always comes before the rewritten ones. ParaView follows the offsets.
 !> A .pvd collection lists the frames with their times.
 !>
 !> Every file is written to <path>.part and renamed onto <path> only when complete and closed,
@@ -61,10 +68,9 @@ contains
 
     character(len=:), allocatable :: xml, tmp
     character(len=msg_len) :: msg
-    integer(int64) :: offset
-    integer(int64), allocatable :: cell_offsets(:)
+    integer(int64), allocatable :: cell_offsets(:), bytes(:), offset(:)
     integer(int8), allocatable :: types(:)
-    integer :: nnode, nelem, i, u, ios
+    integer :: nnode, nelem, i, k, nf, u, ios
 
     nnode = size(x, 2)
     nelem = size(conn, 2)
@@ -92,8 +98,17 @@ contains
     if (allocated(err)) return
 
     ! XML header. Offsets count bytes from just after the '_' that opens the appended data;
-    ! each block is an 8-byte (UInt64) length followed by the values.
-    offset = 0
+    ! each block is an 8-byte (UInt64) length followed by the values. bytes: the blocks' values
+    ! in header order (fields, points, connectivity, offsets, types), written last to first.
+    nf = size(point_fields) + size(cell_fields)
+    bytes = [(field_bytes(point_fields(i)), i=1, size(point_fields)), &
+             (field_bytes(cell_fields(i)), i=1, size(cell_fields)), &
+             8_int64*3*nnode, 8_int64*nen*nelem, 8_int64*nelem, 1_int64*nelem]
+    allocate (offset(size(bytes)))
+    offset(size(bytes)) = 0
+    do k = size(bytes) - 1, 1, -1
+      offset(k) = offset(k + 1) + 8_int64 + bytes(k + 1)
+    end do
     xml = '<?xml version="1.0"?>'//nl &
           //'<VTKFile type="UnstructuredGrid" version="1.0" byte_order="'//byte_order() &
           //'" header_type="UInt64">'//nl &
@@ -102,24 +117,24 @@ contains
     if (size(point_fields) > 0) then
       xml = xml//'      <PointData>'//nl
       do i = 1, size(point_fields)
-        xml = xml//field_array(point_fields(i), offset)
+        xml = xml//field_array(point_fields(i), offset(i))
       end do
       xml = xml//'      </PointData>'//nl
     end if
     if (size(cell_fields) > 0) then
       xml = xml//'      <CellData>'//nl
       do i = 1, size(cell_fields)
-        xml = xml//field_array(cell_fields(i), offset)
+        xml = xml//field_array(cell_fields(i), offset(size(point_fields) + i))
       end do
       xml = xml//'      </CellData>'//nl
     end if
     xml = xml//'      <Points>'//nl &
-          //data_array('Float64', 'Points', 3, offset, 8_int64*3*nnode) &
+          //data_array('Float64', 'Points', 3, offset(nf + 1)) &
           //'      </Points>'//nl &
           //'      <Cells>'//nl &
-          //data_array('Int64', 'connectivity', 1, offset, 8_int64*nen*nelem) &
-          //data_array('Int64', 'offsets', 1, offset, 8_int64*nelem) &
-          //data_array('UInt8', 'types', 1, offset, 1_int64*nelem) &
+          //data_array('Int64', 'connectivity', 1, offset(nf + 2)) &
+          //data_array('Int64', 'offsets', 1, offset(nf + 3)) &
+          //data_array('UInt8', 'types', 1, offset(nf + 4)) &
           //'      </Cells>'//nl &
           //'    </Piece>'//nl &
           //'  </UnstructuredGrid>'//nl &
@@ -137,20 +152,21 @@ contains
       return
     end if
 
-    ! Same order as the offsets assigned above. The meshio reader needs the data block to
-    ! be followed directly by a newline.
+    ! The blocks in the reverse order of the header, at the offsets assigned above (module
+    ! header: meshio). The meshio reader needs the data block to be followed directly by a
+    ! newline.
     write (u, iostat=ios, iomsg=msg) xml
-    do i = 1, size(point_fields)
-      if (ios == 0) call write_field(u, point_fields(i), ios, msg)
-    end do
-    do i = 1, size(cell_fields)
-      if (ios == 0) call write_field(u, cell_fields(i), ios, msg)
-    end do
-    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, size(x, kind=int64)), x
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(1, int(nelem, int64)), types
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, int(nelem, int64)), cell_offsets
     if (ios == 0) write (u, iostat=ios, iomsg=msg) &
       nbytes(8, size(conn, kind=int64)), int(conn, int64) - 1_int64   ! VTK numbers from 0
-    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, int(nelem, int64)), cell_offsets
-    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(1, int(nelem, int64)), types
+    if (ios == 0) write (u, iostat=ios, iomsg=msg) nbytes(8, size(x, kind=int64)), x
+    do i = size(cell_fields), 1, -1
+      if (ios == 0) call write_field(u, cell_fields(i), ios, msg)
+    end do
+    do i = size(point_fields), 1, -1
+      if (ios == 0) call write_field(u, point_fields(i), ios, msg)
+    end do
     if (ios == 0) write (u, iostat=ios, iomsg=msg) nl//'  </AppendedData>'//nl//'</VTKFile>'//nl
 
     call finish(u, ios, msg, tmp, trim(path), 'write_vtu', err)
@@ -251,17 +267,23 @@ contains
     end do
   end subroutine check_fields
 
-  !> The <DataArray .../> line of a field at offset (Float32 or Float64); advances offset.
+  !> The <DataArray .../> line of a field at offset (Float32 or Float64).
   function field_array(f, offset) result(s)
     type(field_t), intent(in) :: f
-    integer(int64), intent(inout) :: offset
+    integer(int64), intent(in) :: offset
     character(len=:), allocatable :: s
     if (f%single) then
-      s = data_array('Float32', f%name, size(f%v, 1), offset, 4_int64*size(f%v, kind=int64))
+      s = data_array('Float32', f%name, size(f%v, 1), offset)
     else
-      s = data_array('Float64', f%name, size(f%v, 1), offset, 8_int64*size(f%v, kind=int64))
+      s = data_array('Float64', f%name, size(f%v, 1), offset)
     end if
   end function field_array
+
+  !> The bytes of a field's values in its block, as write_field writes them
+  pure integer(int64) function field_bytes(f)
+    type(field_t), intent(in) :: f
+    field_bytes = merge(4_int64, 8_int64, f%single)*size(f%v, kind=int64)
+  end function field_bytes
 
   !> A field's appended block: its byte count, then its values as declared by field_array.
   subroutine write_field(u, f, ios, msg)
@@ -276,18 +298,15 @@ contains
     end if
   end subroutine write_field
 
-  !> One <DataArray .../> line for appended data at offset; advances offset past this
-  !> array's block (8-byte length header + nbytes of values).
-  function data_array(vtk_type, name, ncomp, offset, nbytes) result(s)
+  !> One <DataArray .../> line for appended data at offset.
+  function data_array(vtk_type, name, ncomp, offset) result(s)
     character(len=*), intent(in) :: vtk_type, name
     integer, intent(in) :: ncomp
-    integer(int64), intent(inout) :: offset
-    integer(int64), intent(in) :: nbytes
+    integer(int64), intent(in) :: offset
     character(len=:), allocatable :: s
     s = '        <DataArray type="'//vtk_type//'" Name="'//xml_escape(name) &
         //'" NumberOfComponents="'//itoa(ncomp)//'" format="appended" offset="' &
         //itoa(offset)//'"/>'//nl
-    offset = offset + 8_int64 + nbytes
   end function data_array
 
   !> The UInt64 length header of an appended block of n values of bytes_per_value each.
