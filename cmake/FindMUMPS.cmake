@@ -4,6 +4,7 @@
 # directory is passed explicitly.
 find_path(MUMPS_INCLUDE_DIR dmumps_struc.h)
 find_library(MUMPS_DMUMPS_LIBRARY dmumps)
+find_library(MUMPS_SMUMPS_LIBRARY smumps)
 find_library(MUMPS_COMMON_LIBRARY mumps_common)
 find_library(MUMPS_PORD_LIBRARY pord)
 find_library(MUMPS_SCALAPACK_LIBRARY NAMES scalapack-openmpi scalapack)
@@ -13,7 +14,7 @@ find_package_handle_standard_args(MUMPS REQUIRED_VARS MUMPS_DMUMPS_LIBRARY MUMPS
   MUMPS_INCLUDE_DIR MUMPS_SCALAPACK_LIBRARY)
 if(MUMPS_FOUND AND NOT TARGET MUMPS::MUMPS)
   add_library(MUMPS::MUMPS INTERFACE IMPORTED)
-  set(_libs ${MUMPS_DMUMPS_LIBRARY} ${MUMPS_COMMON_LIBRARY})
+  set(_libs ${MUMPS_DMUMPS_LIBRARY} ${MUMPS_SMUMPS_LIBRARY} ${MUMPS_COMMON_LIBRARY})
   if(MUMPS_PORD_LIBRARY)
     list(APPEND _libs ${MUMPS_PORD_LIBRARY})
   endif()

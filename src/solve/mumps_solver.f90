@@ -12,16 +12,23 @@ module casca_mumps_solver
   public :: sparse_solver_t, mumps_version
 
   include 'dmumps_struc.h'
+  include 'smumps_struc.h'
 
   interface   ! MUMPS ships no module: the one entry point, declared here
     subroutine dmumps(id)
       import :: dmumps_struc
       type(dmumps_struc), intent(inout) :: id
     end subroutine dmumps
+    subroutine smumps(id)
+      import :: smumps_struc
+      type(smumps_struc), intent(inout) :: id
+    end subroutine smumps
   end interface
 
   type :: sparse_solver_t
     type(dmumps_struc), private :: id
+    type(smumps_struc), private :: sid   !< MEASUREMENT: single-precision factors (CASCA_SINGLE=1)
+    logical :: single = .false.
     logical :: started = .false.
     integer :: ngroups = 1          !< the ranks are dealt into this many groups (one instance each)
     logical :: analysed = .false.
@@ -79,8 +86,60 @@ contains
     self%id%icntl(14) = 40            ! workspace margin (percent)
     self%id%icntl(13) = 1             ! no ScaLAPACK root: cheaper for our small fronts
     self%id%icntl(24) = 0
+    call measurement_options(self)
     self%started = .true.
   end subroutine solver_init
+
+  !> MEASUREMENT ONLY (issue 18): CASCA_BLR=eps switches block low-rank on (ICNTL(35) =
+  !> CASCA_BLR_MODE, default 2; ICNTL(36) = CASCA_BLR_VARIANT, default 0; CNTL(7) = eps);
+  !> CASCA_SINGLE=1 factorises and solves in single precision (smumps), Newton's residual
+  !> staying in double.
+  subroutine measurement_options(self)
+    class(sparse_solver_t), intent(inout) :: self
+    character(len=64) :: v
+    integer :: l, st, mode, variant
+    real(dp) :: eps
+    call get_environment_variable('CASCA_SINGLE', v, l, st)
+    self%single = st == 0 .and. trim(v) == '1'
+    if (self%single) then
+      self%sid%comm = self%id%comm; self%sid%sym = 2; self%sid%par = 1
+      self%sid%job = -1
+      call smumps(self%sid)
+      self%sid%icntl = self%id%icntl
+    end if
+    call get_environment_variable('CASCA_BLR', v, l, st)
+    if (st /= 0) return
+    read (v, *) eps
+    mode = 2; variant = 0
+    call get_environment_variable('CASCA_BLR_MODE', v, l, st)
+    if (st == 0) read (v, *) mode
+    call get_environment_variable('CASCA_BLR_VARIANT', v, l, st)
+    if (st == 0) read (v, *) variant
+    self%id%icntl(35) = mode; self%id%icntl(36) = variant; self%id%cntl(7) = eps
+    if (self%single) then
+      self%sid%icntl(35) = mode; self%sid%icntl(36) = variant; self%sid%cntl(7) = real(eps)
+    end if
+  end subroutine measurement_options
+
+  !> MEASUREMENT ONLY: CASCA_MUMPS_STATS=1 prints, after each factorisation on the host, the
+  !> order, the factor entries forecast full-rank (INFOG(29) after analysis is not set: INFOG(20)
+  !> estimate) and effective (INFOG(29)), the flops forecast (RINFOG(3)) and done (RINFOG(14)).
+  subroutine measurement_stats(self)
+    class(sparse_solver_t), intent(in) :: self
+    character(len=8) :: v
+    integer :: l, st
+    call get_environment_variable('CASCA_MUMPS_STATS', v, l, st)
+    if (st /= 0 .or. .not. self%host()) return
+    if (self%single) then
+      write (0, '(a,i0,a,i0,a,i0,a,es10.3,a,es10.3,a,i0)') 'mumps(s): n ', self%sid%n, ' factors full ', &
+        self%sid%infog(20), ' effective ', self%sid%infog(29), ' flops ', self%sid%rinfog(3), &
+        ' blr flops ', self%sid%rinfog(14), ' maxfront ', self%sid%infog(11)
+    else
+      write (0, '(a,i0,a,i0,a,i0,a,es10.3,a,es10.3,a,i0)') 'mumps(d): n ', self%id%n, ' factors full ', &
+        self%id%infog(20), ' effective ', self%id%infog(29), ' flops ', self%id%rinfog(3), &
+        ' blr flops ', self%id%rinfog(14), ' maxfront ', self%id%infog(11)
+    end if
+  end subroutine measurement_stats
 
   !> Symbolic analysis of the pattern irn(k) >= jcn(k) (this rank's entries; duplicates sum)
   !> of this rank's group (ngroups groups; 1 if absent). perm: pivot order (host), used when
@@ -108,8 +167,23 @@ contains
       allocate (self%id%perm_in(n))
       self%id%perm_in = perm
     end if
+    if (self%single) then
+      if (associated(self%sid%irn_loc)) deallocate (self%sid%irn_loc, self%sid%jcn_loc, self%sid%a_loc)
+      self%sid%n = n; self%sid%nnz_loc = size(irn, kind=8)
+      allocate (self%sid%irn_loc(size(irn)), self%sid%jcn_loc(size(irn)), self%sid%a_loc(size(irn)))
+      self%sid%irn_loc = irn; self%sid%jcn_loc = jcn; self%sid%a_loc = 0
+      if (associated(self%sid%perm_in)) deallocate (self%sid%perm_in)
+      self%sid%icntl(7) = self%ordering
+      if (self%ordering == 1 .and. self%host()) then
+        allocate (self%sid%perm_in(n)); self%sid%perm_in = perm
+      end if
+      self%sid%job = 1
+      call smumps(self%sid)
+      self%id%infog(1:2) = self%sid%infog(1:2)
+    else
     self%id%job = 1
     call dmumps(self%id)
+    end if
     call check(self, 'analysis', err)
     self%analysed = .not. allocated(err)
     self%factored = .false.
@@ -121,6 +195,16 @@ contains
     real(dp), intent(in) :: a(:)
     type(error_t), allocatable, intent(out) :: err
     integer :: attempt
+    if (self%single) then
+      self%sid%a_loc = real(a, kind(self%sid%a_loc))
+      do attempt = 1, 4
+        self%sid%job = 2
+        call smumps(self%sid)
+        if (self%sid%infog(1) /= -8 .and. self%sid%infog(1) /= -9) exit
+        self%sid%icntl(14) = 2*self%sid%icntl(14)
+      end do
+      self%id%infog(1:2) = self%sid%infog(1:2); self%id%infog(12) = self%sid%infog(12)
+    else
     self%id%a_loc = a
     do attempt = 1, 4
       self%id%job = 2
@@ -129,8 +213,10 @@ contains
       if (self%id%infog(1) /= -8 .and. self%id%infog(1) /= -9) exit
       self%id%icntl(14) = 2*self%id%icntl(14)
     end do
+    end if
     call check(self, 'factorisation', err)
     self%factored = .not. allocated(err)
+    call measurement_stats(self)
   end subroutine solver_factorise
 
   !> X = K^-1 B for m right-hand sides at once (B, X: (n, m)); B is needed on the host only,
@@ -142,6 +228,23 @@ contains
     type(error_t), allocatable, intent(out) :: err
     integer :: n, m
     n = size(b, 1); m = size(b, 2)
+    if (self%single) then
+      if (self%host()) then
+        if (associated(self%sid%rhs)) then
+          if (size(self%sid%rhs) /= n*m) deallocate (self%sid%rhs)
+        end if
+        if (.not. associated(self%sid%rhs)) allocate (self%sid%rhs(n*m))
+        self%sid%rhs = real(reshape(b, [n*m]), kind(self%sid%rhs))
+      end if
+      self%sid%nrhs = m; self%sid%lrhs = n
+      self%sid%job = 3
+      call smumps(self%sid)
+      self%id%infog(1:2) = self%sid%infog(1:2)
+      call check(self, 'solution', err)
+      x = 0
+      if (self%host() .and. .not. allocated(err)) x = reshape(real(self%sid%rhs, dp), [n, m])
+      return
+    end if
     if (self%host()) then
       if (associated(self%id%rhs)) then
         if (size(self%id%rhs) /= n*m) deallocate (self%id%rhs)
@@ -192,6 +295,13 @@ contains
     if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
     self%id%job = -2
     call dmumps(self%id)
+    if (self%single) then
+      if (associated(self%sid%irn_loc)) deallocate (self%sid%irn_loc, self%sid%jcn_loc, self%sid%a_loc)
+      if (associated(self%sid%rhs)) deallocate (self%sid%rhs)
+      if (associated(self%sid%perm_in)) deallocate (self%sid%perm_in)
+      self%sid%job = -2
+      call smumps(self%sid)
+    end if
     self%started = .false.; self%analysed = .false.; self%factored = .false.
   end subroutine solver_finish
 
