@@ -2,7 +2,8 @@
 !> group_handle; all ranks when there is one group), with the matrix distributed over the
 !> group as assembled entries (ICNTL(18) = 3) and right-hand side and solution on the group's
 !> host (its first rank). The analysis is kept while the sparsity pattern does not change;
-!> each Newton iteration only refactorises (JOB = 2) and solves (JOB = 3).
+!> each Newton iteration only refactorises (JOB = 2) and solves (JOB = 3). With single, a
+!> single-precision instance (SMUMPS, same settings) analyses, factorises and solves instead.
 module casca_mumps_solver
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -27,7 +28,11 @@ module casca_mumps_solver
 
   type :: sparse_solver_t
     type(dmumps_struc), private :: id
-    type(smumps_struc), private :: sid   !< MEASUREMENT: single-precision factors (CASCA_SINGLE=1)
+    type(smumps_struc), private :: sid  !< the instance that works when single
+    !> factorise and solve in single precision (SMUMPS; &run factor_precision = 'single'):
+    !> the matrix and right-hand sides are rounded to single, the solution returned in double.
+    !> Set before the first analysis. Newton's residual stays in double, so its iterations
+    !> refine the solution (docs/performance.md: the same answers, the same iterations)
     logical :: single = .false.
     logical :: started = .false.
     integer :: ngroups = 1          !< the ranks are dealt into this many groups (one instance each)
@@ -86,60 +91,14 @@ contains
     self%id%icntl(14) = 40            ! workspace margin (percent)
     self%id%icntl(13) = 1             ! no ScaLAPACK root: cheaper for our small fronts
     self%id%icntl(24) = 0
-    call measurement_options(self)
-    self%started = .true.
-  end subroutine solver_init
-
-  !> MEASUREMENT ONLY (issue 18): CASCA_BLR=eps switches block low-rank on (ICNTL(35) =
-  !> CASCA_BLR_MODE, default 2; ICNTL(36) = CASCA_BLR_VARIANT, default 0; CNTL(7) = eps);
-  !> CASCA_SINGLE=1 factorises and solves in single precision (smumps), Newton's residual
-  !> staying in double.
-  subroutine measurement_options(self)
-    class(sparse_solver_t), intent(inout) :: self
-    character(len=64) :: v
-    integer :: l, st, mode, variant
-    real(dp) :: eps
-    call get_environment_variable('CASCA_SINGLE', v, l, st)
-    self%single = st == 0 .and. trim(v) == '1'
-    if (self%single) then
-      self%sid%comm = self%id%comm; self%sid%sym = 2; self%sid%par = 1
+    if (self%single) then   ! the same settings; the double instance then holds no matrix
+      self%sid%comm = self%id%comm; self%sid%sym = self%id%sym; self%sid%par = self%id%par
       self%sid%job = -1
       call smumps(self%sid)
       self%sid%icntl = self%id%icntl
     end if
-    call get_environment_variable('CASCA_BLR', v, l, st)
-    if (st /= 0) return
-    read (v, *) eps
-    mode = 2; variant = 0
-    call get_environment_variable('CASCA_BLR_MODE', v, l, st)
-    if (st == 0) read (v, *) mode
-    call get_environment_variable('CASCA_BLR_VARIANT', v, l, st)
-    if (st == 0) read (v, *) variant
-    self%id%icntl(35) = mode; self%id%icntl(36) = variant; self%id%cntl(7) = eps
-    if (self%single) then
-      self%sid%icntl(35) = mode; self%sid%icntl(36) = variant; self%sid%cntl(7) = real(eps)
-    end if
-  end subroutine measurement_options
-
-  !> MEASUREMENT ONLY: CASCA_MUMPS_STATS=1 prints, after each factorisation on the host, the
-  !> order, the factor entries forecast full-rank (INFOG(29) after analysis is not set: INFOG(20)
-  !> estimate) and effective (INFOG(29)), the flops forecast (RINFOG(3)) and done (RINFOG(14)).
-  subroutine measurement_stats(self)
-    class(sparse_solver_t), intent(in) :: self
-    character(len=8) :: v
-    integer :: l, st
-    call get_environment_variable('CASCA_MUMPS_STATS', v, l, st)
-    if (st /= 0 .or. .not. self%host()) return
-    if (self%single) then
-      write (0, '(a,i0,a,i0,a,i0,a,es10.3,a,es10.3,a,i0)') 'mumps(s): n ', self%sid%n, ' factors full ', &
-        self%sid%infog(20), ' effective ', self%sid%infog(29), ' flops ', self%sid%rinfog(3), &
-        ' blr flops ', self%sid%rinfog(14), ' maxfront ', self%sid%infog(11)
-    else
-      write (0, '(a,i0,a,i0,a,i0,a,es10.3,a,es10.3,a,i0)') 'mumps(d): n ', self%id%n, ' factors full ', &
-        self%id%infog(20), ' effective ', self%id%infog(29), ' flops ', self%id%rinfog(3), &
-        ' blr flops ', self%id%rinfog(14), ' maxfront ', self%id%infog(11)
-    end if
-  end subroutine measurement_stats
+    self%started = .true.
+  end subroutine solver_init
 
   !> Symbolic analysis of the pattern irn(k) >= jcn(k) (this rank's entries; duplicates sum)
   !> of this rank's group (ngroups groups; 1 if absent). perm: pivot order (host), used when
@@ -154,39 +113,48 @@ contains
     else
       call self%init(1)
     end if
-    if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
-    self%id%n = n
-    self%id%nnz_loc = size(irn, kind=8)
-    allocate (self%id%irn_loc(size(irn)), self%id%jcn_loc(size(irn)), self%id%a_loc(size(irn)))
-    self%id%irn_loc = irn
-    self%id%jcn_loc = jcn
-    self%id%a_loc = 0
-    if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
-    self%id%icntl(7) = self%ordering
-    if (self%ordering == 1 .and. self%host()) then
-      allocate (self%id%perm_in(n))
-      self%id%perm_in = perm
-    end if
     if (self%single) then
-      if (associated(self%sid%irn_loc)) deallocate (self%sid%irn_loc, self%sid%jcn_loc, self%sid%a_loc)
-      self%sid%n = n; self%sid%nnz_loc = size(irn, kind=8)
-      allocate (self%sid%irn_loc(size(irn)), self%sid%jcn_loc(size(irn)), self%sid%a_loc(size(irn)))
-      self%sid%irn_loc = irn; self%sid%jcn_loc = jcn; self%sid%a_loc = 0
-      if (associated(self%sid%perm_in)) deallocate (self%sid%perm_in)
-      self%sid%icntl(7) = self%ordering
-      if (self%ordering == 1 .and. self%host()) then
-        allocate (self%sid%perm_in(n)); self%sid%perm_in = perm
-      end if
-      self%sid%job = 1
-      call smumps(self%sid)
-      self%id%infog(1:2) = self%sid%infog(1:2)
+      call analyse_single(self%sid)
+      self%id%infog(1:2) = self%sid%infog(1:2)   ! (check reads id)
     else
-    self%id%job = 1
-    call dmumps(self%id)
+      if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
+      self%id%n = n
+      self%id%nnz_loc = size(irn, kind=8)
+      allocate (self%id%irn_loc(size(irn)), self%id%jcn_loc(size(irn)), self%id%a_loc(size(irn)))
+      self%id%irn_loc = irn
+      self%id%jcn_loc = jcn
+      self%id%a_loc = 0
+      if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
+      self%id%icntl(7) = self%ordering
+      if (self%ordering == 1 .and. self%host()) then
+        allocate (self%id%perm_in(n))
+        self%id%perm_in = perm
+      end if
+      self%id%job = 1
+      call dmumps(self%id)
     end if
     call check(self, 'analysis', err)
     self%analysed = .not. allocated(err)
     self%factored = .false.
+  contains
+    subroutine analyse_single(sid)   ! the same, on the single-precision instance
+      type(smumps_struc), intent(inout) :: sid
+      if (associated(sid%irn_loc)) deallocate (sid%irn_loc, sid%jcn_loc, sid%a_loc)
+      sid%n = n
+      sid%nnz_loc = size(irn, kind=8)
+      allocate (sid%irn_loc(size(irn)), sid%jcn_loc(size(irn)), sid%a_loc(size(irn)))
+      sid%irn_loc = irn
+      sid%jcn_loc = jcn
+      sid%a_loc = 0
+      if (associated(sid%perm_in)) deallocate (sid%perm_in)
+      sid%icntl(7) = self%ordering
+      if (self%ordering == 1 .and. self%host()) then
+        allocate (sid%perm_in(n))
+        sid%perm_in = perm
+      end if
+      sid%job = 1
+      call smumps(sid)
+    end subroutine analyse_single
   end subroutine solver_analyse
 
   !> Numerical factorisation of this rank's values (same order as the analysed pattern).
@@ -195,7 +163,7 @@ contains
     real(dp), intent(in) :: a(:)
     type(error_t), allocatable, intent(out) :: err
     integer :: attempt
-    if (self%single) then
+    if (self%single) then   ! (as below, in single precision)
       self%sid%a_loc = real(a, kind(self%sid%a_loc))
       do attempt = 1, 4
         self%sid%job = 2
@@ -205,18 +173,17 @@ contains
       end do
       self%id%infog(1:2) = self%sid%infog(1:2); self%id%infog(12) = self%sid%infog(12)
     else
-    self%id%a_loc = a
-    do attempt = 1, 4
-      self%id%job = 2
-      call dmumps(self%id)
-      ! -8, -9: workspace too small (more pivoting than the analysis forecast): grow and retry
-      if (self%id%infog(1) /= -8 .and. self%id%infog(1) /= -9) exit
-      self%id%icntl(14) = 2*self%id%icntl(14)
-    end do
+      self%id%a_loc = a
+      do attempt = 1, 4
+        self%id%job = 2
+        call dmumps(self%id)
+        ! -8, -9: workspace too small (more pivoting than the analysis forecast): grow and retry
+        if (self%id%infog(1) /= -8 .and. self%id%infog(1) /= -9) exit
+        self%id%icntl(14) = 2*self%id%icntl(14)
+      end do
     end if
     call check(self, 'factorisation', err)
     self%factored = .not. allocated(err)
-    call measurement_stats(self)
   end subroutine solver_factorise
 
   !> X = K^-1 B for m right-hand sides at once (B, X: (n, m)); B is needed on the host only,
