@@ -208,6 +208,7 @@ contains
       call assembly_setup(model, r%asm, r%err, split=r%ls%schur)
       if (failed(r, 'setup')) return
       if (deck%run%ordering == 'metis') r%ls%solver%ordering = 1
+      r%ls%solver%single = deck%run%factor_precision == 'single'   ! (K only: M stays double)
       r%opts%tol = deck%run%newton_tol; r%opts%max_iter = deck%run%newton_max_iter
       r%opts%reuse = deck%run%reuse_factorisation
       allocate (r%fext(model%ndof))

@@ -50,6 +50,7 @@ module casca_deck
     logical :: load_stiffness = .true.          !< the follower pressures' load stiffness in Newton
     real(dp) :: gravity(3) = 0
     character(len=16) :: ordering = 'auto'      !< 'auto' (MUMPS) or 'metis'
+    character(len=16) :: factor_precision = 'double'   !< K's factors: 'double' or 'single'
     integer :: line = 0
   end type run_cfg_t
 
@@ -447,13 +448,13 @@ contains
   subroutine read_run(u, deck, line)
     integer, intent(in) :: u, line
     type(deck_t), intent(inout) :: deck
-    character(len=long) :: title, analysis, ordering
+    character(len=long) :: title, analysis, ordering, factor_precision
     real(dp) :: dt, t_end, beta, gamma, rho_inf, tolerance, tolerance_length, newton_tol, gravity(3)
     integer :: newton_max_iter, load_steps, max_step_cuts, ios
     logical :: reuse_factorisation, skip_idle_bodies, load_stiffness
     character(len=256) :: msg
     namelist /run/ title, analysis, dt, t_end, beta, gamma, rho_inf, tolerance, tolerance_length, &
-      newton_tol, newton_max_iter, load_steps, max_step_cuts, gravity, ordering, &
+      newton_tol, newton_max_iter, load_steps, max_step_cuts, gravity, ordering, factor_precision, &
       reuse_factorisation, skip_idle_bodies, load_stiffness
     associate (c => deck%run)
       ! (beta and gamma read as unset: given with rho_inf they are refused, not overridden)
@@ -461,7 +462,8 @@ contains
       gamma = unset; rho_inf = c%rho_inf; tolerance = c%tolerance
       tolerance_length = c%tolerance_length; newton_tol = c%newton_tol; newton_max_iter = c%newton_max_iter
       load_steps = c%load_steps; max_step_cuts = c%max_step_cuts; gravity = c%gravity
-      ordering = c%ordering; reuse_factorisation = c%reuse_factorisation
+      ordering = c%ordering; factor_precision = c%factor_precision
+      reuse_factorisation = c%reuse_factorisation
       skip_idle_bodies = c%skip_idle_bodies
       load_stiffness = c%load_stiffness
       c%line = line
@@ -474,6 +476,7 @@ contains
       call take(deck, line, '&run: title', title, c%title)
       call take(deck, line, '&run: analysis', lower(analysis), c%analysis)
       call take(deck, line, '&run: ordering', lower(ordering), c%ordering)
+      call take(deck, line, '&run: factor_precision', lower(factor_precision), c%factor_precision)
       c%dt = dt; c%t_end = t_end; c%rho_inf = rho_inf
       c%tolerance = tolerance; c%tolerance_length = tolerance_length
       if (rho_inf /= unset .and. (beta /= unset .or. gamma /= unset)) call add_problem(deck, line, &

@@ -15,6 +15,7 @@ module casca_deck_lint
   end type key_t
   type(key_t), parameter :: keys(*) = [ &
     key_t('run', 'title', 's'), key_t('run', 'analysis', 's'), key_t('run', 'ordering', 's'), &
+    key_t('run', 'factor_precision', 's'), &
     key_t('run', 'dt', 'r'), key_t('run', 't_end', 'r'), key_t('run', 'beta', 'r'), &
     key_t('run', 'gamma', 'r'), key_t('run', 'rho_inf', 'r'), key_t('run', 'newton_tol', 'r'), &
     key_t('run', 'gravity', 'r'), key_t('run', 'tolerance', 'r'), &

@@ -68,6 +68,9 @@ contains
         '&run: max_step_cuts must be in 0..'//itoa(max_cuts)//' (got '//itoa(r%max_step_cuts)//')')
       if (r%ordering /= 'auto' .and. r%ordering /= 'metis') &
         call add_problem(deck, l, '&run: ordering must be ''auto'' or ''metis''')
+      if (r%factor_precision /= 'double' .and. r%factor_precision /= 'single') &
+        call add_problem(deck, l, '&run: factor_precision must be ''double'' or ''single'' (got '''// &
+                         trim(r%factor_precision)//''')')
     end associate
 
     associate (o => deck%output, l => deck%output%line)

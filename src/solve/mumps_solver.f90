@@ -2,7 +2,8 @@
 !> group_handle; all ranks when there is one group), with the matrix distributed over the
 !> group as assembled entries (ICNTL(18) = 3) and right-hand side and solution on the group's
 !> host (its first rank). The analysis is kept while the sparsity pattern does not change;
-!> each Newton iteration only refactorises (JOB = 2) and solves (JOB = 3).
+!> each Newton iteration only refactorises (JOB = 2) and solves (JOB = 3). With single, a
+!> single-precision instance (SMUMPS, same settings) analyses, factorises and solves instead.
 module casca_mumps_solver
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -12,16 +13,27 @@ module casca_mumps_solver
   public :: sparse_solver_t, mumps_version
 
   include 'dmumps_struc.h'
+  include 'smumps_struc.h'
 
   interface   ! MUMPS ships no module: the one entry point, declared here
     subroutine dmumps(id)
       import :: dmumps_struc
       type(dmumps_struc), intent(inout) :: id
     end subroutine dmumps
+    subroutine smumps(id)
+      import :: smumps_struc
+      type(smumps_struc), intent(inout) :: id
+    end subroutine smumps
   end interface
 
   type :: sparse_solver_t
     type(dmumps_struc), private :: id
+    type(smumps_struc), private :: sid  !< the instance that works when single
+    !> factorise and solve in single precision (SMUMPS; &run factor_precision = 'single'):
+    !> the matrix and right-hand sides are rounded to single, the solution returned in double.
+    !> Set before the first analysis. Newton's residual stays in double, so its iterations
+    !> refine the solution (docs/performance.md: the same answers, the same iterations)
+    logical :: single = .false.
     logical :: started = .false.
     integer :: ngroups = 1          !< the ranks are dealt into this many groups (one instance each)
     logical :: analysed = .false.
@@ -79,6 +91,12 @@ contains
     self%id%icntl(14) = 40            ! workspace margin (percent)
     self%id%icntl(13) = 1             ! no ScaLAPACK root: cheaper for our small fronts
     self%id%icntl(24) = 0
+    if (self%single) then   ! the same settings; the double instance then holds no matrix
+      self%sid%comm = self%id%comm; self%sid%sym = self%id%sym; self%sid%par = self%id%par
+      self%sid%job = -1
+      call smumps(self%sid)
+      self%sid%icntl = self%id%icntl
+    end if
     self%started = .true.
   end subroutine solver_init
 
@@ -95,24 +113,48 @@ contains
     else
       call self%init(1)
     end if
-    if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
-    self%id%n = n
-    self%id%nnz_loc = size(irn, kind=8)
-    allocate (self%id%irn_loc(size(irn)), self%id%jcn_loc(size(irn)), self%id%a_loc(size(irn)))
-    self%id%irn_loc = irn
-    self%id%jcn_loc = jcn
-    self%id%a_loc = 0
-    if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
-    self%id%icntl(7) = self%ordering
-    if (self%ordering == 1 .and. self%host()) then
-      allocate (self%id%perm_in(n))
-      self%id%perm_in = perm
+    if (self%single) then
+      call analyse_single(self%sid)
+      self%id%infog(1:2) = self%sid%infog(1:2)   ! (check reads id)
+    else
+      if (associated(self%id%irn_loc)) deallocate (self%id%irn_loc, self%id%jcn_loc, self%id%a_loc)
+      self%id%n = n
+      self%id%nnz_loc = size(irn, kind=8)
+      allocate (self%id%irn_loc(size(irn)), self%id%jcn_loc(size(irn)), self%id%a_loc(size(irn)))
+      self%id%irn_loc = irn
+      self%id%jcn_loc = jcn
+      self%id%a_loc = 0
+      if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
+      self%id%icntl(7) = self%ordering
+      if (self%ordering == 1 .and. self%host()) then
+        allocate (self%id%perm_in(n))
+        self%id%perm_in = perm
+      end if
+      self%id%job = 1
+      call dmumps(self%id)
     end if
-    self%id%job = 1
-    call dmumps(self%id)
     call check(self, 'analysis', err)
     self%analysed = .not. allocated(err)
     self%factored = .false.
+  contains
+    subroutine analyse_single(sid)   ! the same, on the single-precision instance
+      type(smumps_struc), intent(inout) :: sid
+      if (associated(sid%irn_loc)) deallocate (sid%irn_loc, sid%jcn_loc, sid%a_loc)
+      sid%n = n
+      sid%nnz_loc = size(irn, kind=8)
+      allocate (sid%irn_loc(size(irn)), sid%jcn_loc(size(irn)), sid%a_loc(size(irn)))
+      sid%irn_loc = irn
+      sid%jcn_loc = jcn
+      sid%a_loc = 0
+      if (associated(sid%perm_in)) deallocate (sid%perm_in)
+      sid%icntl(7) = self%ordering
+      if (self%ordering == 1 .and. self%host()) then
+        allocate (sid%perm_in(n))
+        sid%perm_in = perm
+      end if
+      sid%job = 1
+      call smumps(sid)
+    end subroutine analyse_single
   end subroutine solver_analyse
 
   !> Numerical factorisation of this rank's values (same order as the analysed pattern).
@@ -121,14 +163,25 @@ contains
     real(dp), intent(in) :: a(:)
     type(error_t), allocatable, intent(out) :: err
     integer :: attempt
-    self%id%a_loc = a
-    do attempt = 1, 4
-      self%id%job = 2
-      call dmumps(self%id)
-      ! -8, -9: workspace too small (more pivoting than the analysis forecast): grow and retry
-      if (self%id%infog(1) /= -8 .and. self%id%infog(1) /= -9) exit
-      self%id%icntl(14) = 2*self%id%icntl(14)
-    end do
+    if (self%single) then   ! (as below, in single precision)
+      self%sid%a_loc = real(a, kind(self%sid%a_loc))
+      do attempt = 1, 4
+        self%sid%job = 2
+        call smumps(self%sid)
+        if (self%sid%infog(1) /= -8 .and. self%sid%infog(1) /= -9) exit
+        self%sid%icntl(14) = 2*self%sid%icntl(14)
+      end do
+      self%id%infog(1:2) = self%sid%infog(1:2); self%id%infog(12) = self%sid%infog(12)
+    else
+      self%id%a_loc = a
+      do attempt = 1, 4
+        self%id%job = 2
+        call dmumps(self%id)
+        ! -8, -9: workspace too small (more pivoting than the analysis forecast): grow and retry
+        if (self%id%infog(1) /= -8 .and. self%id%infog(1) /= -9) exit
+        self%id%icntl(14) = 2*self%id%icntl(14)
+      end do
+    end if
     call check(self, 'factorisation', err)
     self%factored = .not. allocated(err)
   end subroutine solver_factorise
@@ -142,6 +195,23 @@ contains
     type(error_t), allocatable, intent(out) :: err
     integer :: n, m
     n = size(b, 1); m = size(b, 2)
+    if (self%single) then
+      if (self%host()) then
+        if (associated(self%sid%rhs)) then
+          if (size(self%sid%rhs) /= n*m) deallocate (self%sid%rhs)
+        end if
+        if (.not. associated(self%sid%rhs)) allocate (self%sid%rhs(n*m))
+        self%sid%rhs = real(reshape(b, [n*m]), kind(self%sid%rhs))
+      end if
+      self%sid%nrhs = m; self%sid%lrhs = n
+      self%sid%job = 3
+      call smumps(self%sid)
+      self%id%infog(1:2) = self%sid%infog(1:2)
+      call check(self, 'solution', err)
+      x = 0
+      if (self%host() .and. .not. allocated(err)) x = reshape(real(self%sid%rhs, dp), [n, m])
+      return
+    end if
     if (self%host()) then
       if (associated(self%id%rhs)) then
         if (size(self%id%rhs) /= n*m) deallocate (self%id%rhs)
@@ -192,6 +262,13 @@ contains
     if (associated(self%id%perm_in)) deallocate (self%id%perm_in)
     self%id%job = -2
     call dmumps(self%id)
+    if (self%single) then
+      if (associated(self%sid%irn_loc)) deallocate (self%sid%irn_loc, self%sid%jcn_loc, self%sid%a_loc)
+      if (associated(self%sid%rhs)) deallocate (self%sid%rhs)
+      if (associated(self%sid%perm_in)) deallocate (self%sid%perm_in)
+      self%sid%job = -2
+      call smumps(self%sid)
+    end if
     self%started = .false.; self%analysed = .false.; self%factored = .false.
   end subroutine solver_finish
 
