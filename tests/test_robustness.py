@@ -1,7 +1,7 @@
 """Scenes written by others (issue 14: robustness of Newton, statics, contact, energy).
 
 usage: test_robustness.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR [CASE ...]
-  CASE (default all): shipped slit oblique plate_strike trapezoidal
+  CASE (default all): shipped slit oblique plate_strike trapezoidal rim
 
 shipped      every deck in examples/ runs to its end with exit 0. test_scenes.py runs
              strip_wall, two_rings and three_rings whole (exit 0 asserted there), and
@@ -34,6 +34,9 @@ plate_strike a thin steel sphere at 20 m/s onto a clamped steel plate, up to 1.4
              other contact conditions of oblique), total energy never above (1 + 1e-3) E0.
 trapezoidal  the oblique rings with the trapezoidal rule (beta 1/4, gamma 1/2) at the thesis'
              step 5e-5 s and at 10x (5e-4 s), 40 ms: exit 0, max total energy / E0 <= 1.01.
+rim          a tilted spinning hoop falls past the edge of a free plate (a scene not tuned):
+             exit 0, the plate moves, linear momentum to 1e-8, energy never above
+             (1 + 1e-3) E0 with beta 1, gamma 1.5, the contact conditions.
 
 Every bound comes from a published table, an analytic answer or a conservation law; none is
 copied from casca's output. Each case prints its wall time (budget for the file: about 4 minutes
@@ -55,7 +58,7 @@ sys.path.insert(0, os.path.join(HERE, "data"))
 import make_slit_annular_plate as slit_mesh  # noqa: E402
 
 casca, examples, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:5]]
-CASES = sys.argv[5:] or ["shipped", "slit", "oblique", "plate_strike", "trapezoidal"]
+CASES = sys.argv[5:] or ["shipped", "slit", "oblique", "plate_strike", "trapezoidal", "rim"]
 os.makedirs(work, exist_ok=True)
 ck = Checks()
 STEEL_E, STEEL_NU, STEEL_RHO = 210e9, 0.3, 7700.0
@@ -357,6 +360,40 @@ if "trapezoidal" in CASES:
                   % (name, "" if ok else ", up to t = %.4g s" % h["t"][-1]),
                   h["total"].max() / h["total"][0], 1.01)
     timings["trapezoidal"] = time.time() - t0
+
+# --- 6. a hoop passes a free plate's edge ------------------------------------------------
+# A scene written from the README (2026-11-25, not tuned): a steel hoop (R 0.25 m, 5 cm wide,
+# h 4 mm, 24 x 1 cells) tilted 20 degrees about x, centred over the corner of a free
+# aluminium plate (1 m square from the origin, h 6 mm, 6 x 6 cells), spinning at 15 rad/s
+# about z and falling at 6 m/s: its lowest nodes pass beside the plate's edge y = 0 and others
+# land on it. Before: a node beside the edge was taken along the plate's normal (its
+# nearest point on the rim, "penetrating" by being below the plane) while the plate was left
+# out of the equations as idle, and the hoop was thrown back with 60 times its energy
+# (exit 3). Asserted: exit 0; the plate moves (kinetic energy > 0 once struck); linear
+# momentum kept to 1e-8 (the plate is free); total energy never above (1 + 1e-3) E0 with
+# beta 1, gamma 1.5 (which only dissipates); the contact conditions.
+if "rim" in CASES:
+    t0 = time.time()
+    deck = os.path.join(work, "rim.nml")
+    with open(deck, "w") as f:
+        f.write("""&run dt = 5e-5, t_end = 0.03, beta = 1.0, gamma = 1.5 /
+&output interval = 1e-3, vtu = .false., plots = .false. /
+&body name = 'hoop', mesh = 'ring', radius = 0.25, width = 0.05, n_around = 24, n_across = 1,
+  young = 200e9, density = 7800, thickness = 0.004, rotate_axis = 1.0, 0.0, 0.0, rotate_angle = 20.0,
+  center = 0.0, 0.0, 0.16, velocity = 1.0, 0.0, -6.0, omega = 0.0, 0.0, 15.0 /
+&body name = 'panel', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 6, ny = 6, young = 70e9, density = 2700,
+  thickness = 0.006 /
+""")
+    h, ok = run_deck("rim", deck)
+    if h is not None:
+        ck.record("rim: the hoop strikes the plate and the plate moves",
+                  h["contacts"].max() > 0 and h["kinetic_panel"].max() > 0,
+                  "contacts %d, plate's kinetic energy %.3g J" % (h["contacts"].max(), h["kinetic_panel"].max()))
+        ck.le("rim: linear momentum kept, max |p - p0| / |p0|", momentum_error(h), 1e-8)
+        ck.le("rim: total energy never above (1 + 1e-3) E0 (max E / E0)",
+              h["total"].max() / h["total"][0], 1.0 + 1e-3)
+        contact_conditions("rim", h, np.linalg.norm([1.25, 1.229, 0.307]))  # the two bodies' box
+    timings["rim"] = time.time() - t0
 
 print("wall time per case: " + ", ".join("%s %.1f s" % kv for kv in timings.items()))
 ck.finish()

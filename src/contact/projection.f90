@@ -20,6 +20,7 @@ module casca_contact_projection
   use casca_vectors, only: cross
   use casca_surface_search, only: grid_build, nearest_subtriangle, subtri_parent_xi
   use casca_obstacle, only: obstacle_point
+  use casca_closest_point, only: region_face
   use casca_contact, only: contact_t, constraint_t, search_radius
   implicit none
   private
@@ -86,6 +87,15 @@ contains
         nt = cross(x(:, t(2)) - x(:, t(1)), x(:, t(3)) - x(:, t(1)))
       end associate
       con%sd = sign(dist, dot_product(x(:, node) - xq, nt))
+      ! beside an open surface's rim (the nearest point on an edge or a vertex, the node off
+      ! to the side of the sub-triangle's plane, not above or behind it) there is nothing to
+      ! press on: taken along the normal, a hoop passing a plate's edge was thrown back with
+      ! 60 times its energy. (Across an edge inside a surface the node lies within the
+      ! neighbours' normals, well inside this cone.)
+      if (region /= region_face .and. abs(dot_product(x(:, node) - xq, nt)) < 0.5_dp*dist*norm2(nt)) then
+        ok = .false.
+        return
+      end if
       con%node = node; con%pair = p; con%elem = g%surf(bt)%elem(itri)
       call subtri_parent_xi(g%surf(bt), itri, bary, con%xi)
     end associate
