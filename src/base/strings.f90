@@ -3,7 +3,7 @@ module casca_strings
   use, intrinsic :: iso_fortran_env, only: int32, int64, real64
   implicit none
   private
-  public :: itoa, rtoa, count_of
+  public :: itoa, rtoa, ftoa, count_of
 
   !> n as its shortest decimal text (default and 64-bit integers, e.g. HDF5's hsize_t)
   interface itoa
@@ -34,6 +34,17 @@ contains
     write (b, '(es12.4)') x
     s = trim(adjustl(b))
   end function rtoa
+
+  !> x with 3 decimals and a leading zero, e.g. 3.780, 0.125, -0.004 (percentages)
+  pure function ftoa(x) result(s)
+    real(real64), intent(in) :: x
+    character(len=:), allocatable :: s
+    character(len=24) :: b
+    write (b, '(f0.3)') x
+    s = trim(adjustl(b))
+    if (s(1:1) == '.') s = '0'//s
+    if (s(1:2) == '-.') s = '-0'//s(2:)
+  end function ftoa
 
   !> n and the noun in the number n asks for: count_of(1, 'body', 'bodies') is '1 body',
   !> count_of(3, 'body', 'bodies') is '3 bodies' (0 takes the plural)

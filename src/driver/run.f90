@@ -33,7 +33,7 @@ module casca_run
   use casca_files, only: folder_of
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
-  use casca_strings, only: count_of
+  use casca_strings, only: count_of, rtoa, ftoa
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   implicit none
   private
@@ -60,6 +60,10 @@ module casca_run
     real(dp) :: dt_try = 0                      !< with sc: the next step's length
     logical :: landing = .false.                !< this step ends at a predicted contact
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
+    !> the energy a step made (the remainder of the balance fell): the largest, when, and the
+    !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
+    real(dp) :: rest_last = 0, made_max = 0, t_made = 0
+    integer :: made_contacts = 0
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
     type(error_t), allocatable :: err
@@ -273,6 +277,7 @@ contains
         call start_acceleration(r)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
         r%bal0 = r%bal
+        call watch_energy(r)
         call history_row(r, 0)
         if (failed(r, 'history')) return
         call frame(r)
@@ -327,6 +332,7 @@ contains
         end if
         call timer_start(t_account)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        call watch_energy(r)
         call timer_stop(t_account)
         call timer_start(t_output)
         call history_row(r, rep%iters)
@@ -667,6 +673,7 @@ contains
       if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//r%dir// &
         '/plots.gp was written but not run'
     end if
+    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
     if (.not. is_root() .or. r%quiet) return
     associate (deck => r%deck, model => r%model)
       print '(a)', 'done: '//count_of(r%st%step, 'step', 'steps')//' in '//seconds(wall_time() - r%t0)// &
@@ -683,6 +690,39 @@ contains
       print '(a)', (trim(lines(k)), k=1, size(lines))
     end associate
   end subroutine finish
+  !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
+  !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
+  !> and it may only grow with a dissipative scheme (stay, with a conservative one)
+  subroutine watch_energy(r)
+    type(run_t), intent(inout) :: r
+    type(energy_term_t), allocatable :: terms(:)
+    real(dp) :: rest
+    integer :: k
+    terms = balance_terms(r%deck, r%contact)
+    rest = r%bal0%total - (r%bal%kinetic + r%bal%strain - r%bal%work)
+    do k = 1, size(terms)
+      rest = rest - terms(k)%value
+    end do
+    if (r%st%step > 0 .and. r%rest_last - rest > r%made_max) then
+      r%made_max = r%rest_last - rest; r%t_made = r%st%t
+      r%made_contacts = 0
+      if (allocated(r%contact)) r%made_contacts = r%contact%nact
+    end if
+    r%rest_last = rest
+  end subroutine watch_energy
+
+  !> A run from t = 0 whose step made more than 1e-3 of E0 says so: no scheme casca offers
+  !> makes energy, so it is the contact's doing
+  subroutine warn_energy(r)
+    type(run_t), intent(in) :: r
+    if (r%restart_step >= 0 .or. .not. r%made_max > 1e-3_dp*abs(r%bal0%total)) return
+    write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '// &
+      ftoa(100*r%made_max/abs(r%bal0%total))//'% of the initial energy, with '// &
+      count_of(r%made_contacts, 'contact', 'contacts')//' active: a node that came into a '// &
+      'shell edge-on, through its rim (casca has no edge-to-edge contact), or deep into a '// &
+      'target in one step; look at the frames there, or take a shorter dt'
+  end subroutine warn_energy
+
   !> The energy balance's terms that the scene has: friction's, moving obstacles'
   function balance_terms(deck, contact) result(terms)
     type(deck_t), intent(in) :: deck

@@ -10,7 +10,7 @@ module casca_accounting
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
   use casca_vectors, only: cross
-  use casca_strings, only: rtoa
+  use casca_strings, only: rtoa, ftoa
   implicit none
   private
   public :: balance_t, energy_term_t, account, gravity_load, balance_summary, energy_balance
@@ -156,17 +156,7 @@ contains
     end if
     line = line//', removed by the time integrator and contact '//rtoa(rest)
     if (abs(rest) < 1e6_dp*abs(b0%total)) then   ! (not of an E0 that is zero or nearly)
-      line = line//' ('//pct(100*rest/abs(b0%total))//'% of E0)'
+      line = line//' ('//ftoa(100*rest/abs(b0%total))//'% of E0)'
     end if
-  contains
-    function pct(x) result(str)
-      real(dp), intent(in) :: x
-      character(len=:), allocatable :: str
-      character(len=24) :: w
-      write (w, '(f0.3)') x
-      str = trim(adjustl(w))
-      if (str(1:1) == '.') str = '0'//str
-      if (str(1:2) == '-.') str = '-0'//str(2:)
-    end function pct
   end function energy_balance
 end module casca_accounting
