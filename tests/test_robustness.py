@@ -36,7 +36,10 @@ trapezoidal  the oblique rings with the trapezoidal rule (beta 1/4, gamma 1/2) a
              step 5e-5 s and at 10x (5e-4 s), 40 ms: exit 0, max total energy / E0 <= 1.01.
 rim          a tilted spinning hoop falls past the edge of a free plate (a scene not tuned):
              exit 0, the plate moves, linear momentum to 1e-8, energy never above
-             (1 + 1e-3) E0 with beta 1, gamma 1.5, the contact conditions.
+             (1 + 1e-3) E0 with beta 1, gamma 1.5, the contact conditions, no energy
+             warning. Tilted 30 degrees a node enters the plate edge-on (no edge-to-edge
+             contact: energy is made): the run's end warning gives the step and its share
+             of E0, equal to the history's largest one-step rise (1e-4 s, 1e-3 relative).
 
 Every bound comes from a published table, an analytic answer or a conservation law; none is
 copied from casca's output. Each case prints its wall time (budget for the file: about 4 minutes
@@ -74,6 +77,9 @@ def column(name, h, key):
     return None
 
 
+LAST_STDERR = [""]   # the last run_deck's standard error
+
+
 def run_deck(name, deck, np_ranks=1):
     """Run a deck into WORK/name and record exit 0. Returns (history, ok): the history holds
     the accepted steps even when the run stopped early (None when it has no row), so that
@@ -81,6 +87,7 @@ def run_deck(name, deck, np_ranks=1):
     out = os.path.join(work, name)
     t0 = time.time()
     p = run([casca, "run", deck, "--out", out, "-q"], np_ranks=np_ranks)
+    LAST_STDERR[0] = p.stderr
     dt = time.time() - t0
     print("%s: %.1f s wall on %d rank(s), exit %d" % (name, dt, np_ranks, p.returncode), flush=True)
     ok = p.returncode == 0
@@ -393,6 +400,28 @@ if "rim" in CASES:
         ck.le("rim: total energy never above (1 + 1e-3) E0 (max E / E0)",
               h["total"].max() / h["total"][0], 1.0 + 1e-3)
         contact_conditions("rim", h, np.linalg.norm([1.25, 1.229, 0.307]))  # the two bodies' box
+    ck.record("rim: no energy warning (stderr)", "warning: the step" not in LAST_STDERR[0], LAST_STDERR[0][-300:])
+    # Tilted 30 degrees, a node comes into the plate edge-on (inside its thickness) and one
+    # step pushes it to a face: energy is made, a modelling limit (no edge-to-edge contact)
+    # that the run must report. Asserted: the warning names the step, and its figure equals the
+    # largest one-step rise of the total energy in the history (no loads, no obstacles:
+    # E = kinetic + strain), to 1e-3 of it.
+    with open(deck) as f:
+        text = f.read().replace("rotate_angle = 20.0", "rotate_angle = 30.0")
+    deck30 = os.path.join(work, "rim30.nml")
+    with open(deck30, "w") as f:
+        f.write(text)
+    h, ok = run_deck("rim30", deck30)
+    if h is not None:
+        rise = np.diff(h["total"])
+        k = int(np.argmax(rise))
+        m = re.search(r"warning: the step to t = (\S+) s made (\S+)% of the initial energy", LAST_STDERR[0])
+        ck.record("rim30: the energy warning is printed", m is not None, LAST_STDERR[0][-300:])
+        if m:
+            ck.close("rim30: the warning's step time vs the history's largest one-step rise [s]",
+                     float(m.group(1)), h["t"][k + 1], 1e-4)
+            ck.close("rim30: the warning's figure vs that rise / E0 [%]", float(m.group(2)),
+                     100 * rise[k] / h["total"][0], 1e-3)
     timings["rim"] = time.time() - t0
 
 print("wall time per case: " + ", ".join("%s %.1f s" % kv for kv in timings.items()))
