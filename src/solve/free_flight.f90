@@ -6,7 +6,7 @@
 module casca_free_flight
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t, face_reach, search_radius
+  use casca_contact, only: contact_t, face_reach
   use casca_obstacle, only: obstacle_point
   implicit none
   private
@@ -70,10 +70,7 @@ contains
       i = contact%pair(1, k); j = contact%pair(2, k)
       if (j > 0) then
         if (.not. (far(i) .or. far(j))) cycle
-        ! (at least as far as the contact search looks: a constraint on a body left out of
-        ! the equations would hold it as if fixed)
-        reach = 2*dt*(speed(i) + speed(j)) + max(contact%tol + face_reach(contact, model, i, j), &
-                                                 search_radius(contact, model, i, j))
+        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + face_reach(contact, model, i, j)
       else
         if (.not. far(i)) cycle
         reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%tol + &
