@@ -698,7 +698,7 @@ contains
     type(energy_term_t), allocatable :: terms(:)
     real(dp) :: rest
     integer :: k
-    terms = balance_terms(r%deck, r%contact)
+    allocate (terms, source=balance_terms(r%deck, r%contact))   ! (so gcc 12 sees it set)
     rest = r%bal0%total - (r%bal%kinetic + r%bal%strain - r%bal%work)
     do k = 1, size(terms)
       rest = rest - terms(k)%value

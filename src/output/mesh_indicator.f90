@@ -23,6 +23,7 @@ module casca_mesh_indicator
   use casca_shell_element, only: shell_stress
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_quadrature, only: triangle_rule, gauss_rule
+  use casca_orientation, only: vertex_elements
   implicit none
   private
   public :: indicator_t, mesh_indicator, indicator_lines, element_neighbours, indicator_line_len
@@ -52,25 +53,9 @@ contains
     integer, intent(in) :: conn(:, :), nnode, elem_body(:)
     integer, intent(out) :: nbr(3, size(conn, 2)), nedge(3, size(conn, 2))
     logical, intent(out) :: same(3, size(conn, 2))
-    integer, allocatable :: start(:), at(:), fill(:)
-    integer :: e, f, i, j, k, a, b, jf, nshare
-    allocate (start(nnode + 1), fill(nnode))
-    start = 0
-    do e = 1, size(conn, 2)
-      start(conn(1:3, e) + 1) = start(conn(1:3, e) + 1) + 1
-    end do
-    start(1) = 1
-    do i = 1, nnode
-      start(i + 1) = start(i + 1) + start(i)
-    end do
-    allocate (at(start(nnode + 1) - 1))
-    fill = start(1:nnode)
-    do e = 1, size(conn, 2)
-      do j = 1, 3
-        at(fill(conn(j, e))) = e
-        fill(conn(j, e)) = fill(conn(j, e)) + 1
-      end do
-    end do
+    integer, allocatable :: start(:), at(:)
+    integer :: e, f, j, k, a, b, jf, nshare
+    call vertex_elements(conn, nnode, start, at)
     nbr = 0; nedge = 0; same = .false.
     do e = 1, size(conn, 2)
       do j = 1, 3

@@ -13,7 +13,7 @@ module casca_orientation
   use casca_vectors, only: cross
   implicit none
   private
-  public :: reverse_elements, edge_census_t, edge_census, signed_volume
+  public :: reverse_elements, edge_census_t, edge_census, signed_volume, vertex_elements
 
   !> The node order of the reversed element (casca_mesh's order): vertices 1, 3, 2, so each
   !> edge's two inner nodes are taken from the other end (edge 1-3 of the new element is the
@@ -37,16 +37,12 @@ contains
     conn = conn(reversed, :)
   end subroutine reverse_elements
 
-  !> Every edge between vertex nodes of conn(nen, nelem) (nodes 1..nnode), sorted into
-  !> agreeing, disagreeing (of two elements), open (of one) and branching (of three or more)
-  !> ones. Elements are found through the
-  !> elements at each vertex node, so the work is the mesh's size times a vertex's valence.
-  pure function edge_census(conn, nnode) result(ec)
+  !> The elements at each vertex node of conn(nen, nelem): at(start(n) : start(n+1) - 1)
+  pure subroutine vertex_elements(conn, nnode, start, at)
     integer, intent(in) :: conn(:, :), nnode
-    type(edge_census_t) :: ec
-    integer, allocatable :: start(:), at(:), fill(:)
-    integer :: e, f, i, j, k, a, b, nshare, ja, other
-    logical :: lowest
+    integer, allocatable, intent(out) :: start(:), at(:)
+    integer, allocatable :: fill(:)
+    integer :: e, i, j
     allocate (start(nnode + 1), fill(nnode))
     start = 0
     do e = 1, size(conn, 2)
@@ -64,6 +60,19 @@ contains
         fill(conn(j, e)) = fill(conn(j, e)) + 1
       end do
     end do
+  end subroutine vertex_elements
+
+  !> Every edge between vertex nodes of conn(nen, nelem) (nodes 1..nnode), sorted into
+  !> agreeing, disagreeing (of two elements), open (of one) and branching (of three or more)
+  !> ones. Elements are found through the
+  !> elements at each vertex node, so the work is the mesh's size times a vertex's valence.
+  pure function edge_census(conn, nnode) result(ec)
+    integer, intent(in) :: conn(:, :), nnode
+    type(edge_census_t) :: ec
+    integer, allocatable :: start(:), at(:)
+    integer :: e, f, j, k, a, b, nshare, ja, other
+    logical :: lowest
+    call vertex_elements(conn, nnode, start, at)
     do e = 1, size(conn, 2)
       do j = 1, 3   ! edge a -> b of element e
         a = conn(j, e); b = conn(mod(j, 3) + 1, e)
