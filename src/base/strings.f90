@@ -35,11 +35,15 @@ contains
     s = trim(adjustl(b))
   end function rtoa
 
-  !> x with 3 decimals and a leading zero, e.g. 3.780, 0.125, -0.004 (percentages)
+  !> x with 3 decimals and a leading zero, e.g. 3.780, 0.125, -0.004 (percentages); beyond
+  !> 1e15 (or not a number) as rtoa
   pure function ftoa(x) result(s)
     real(real64), intent(in) :: x
     character(len=:), allocatable :: s
     character(len=24) :: b
+    if (.not. abs(x) < 1e15_real64) then
+      s = rtoa(x); return
+    end if
     write (b, '(f0.3)') x
     s = trim(adjustl(b))
     if (s(1:1) == '.') s = '0'//s

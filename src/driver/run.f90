@@ -63,6 +63,7 @@ module casca_run
     !> the energy a step made (the remainder of the balance fell): the largest, when, and the
     !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
     real(dp) :: rest_last = 0, made_max = 0, t_made = 0
+    real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
     integer :: made_contacts = 0
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
@@ -709,15 +710,23 @@ contains
       if (allocated(r%contact)) r%made_contacts = r%contact%nact
     end if
     r%rest_last = rest
+    r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
   end subroutine watch_energy
 
   !> A run from t = 0 whose step made more than 1e-3 of E0 says so: no scheme casca offers
   !> makes energy, so it is the contact's doing
   subroutine warn_energy(r)
     type(run_t), intent(in) :: r
-    if (r%restart_step >= 0 .or. .not. r%made_max > 1e-3_dp*abs(r%bal0%total)) return
-    write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '// &
-      ftoa(100*r%made_max/abs(r%bal0%total))//'% of the initial energy, with '// &
+    character(len=:), allocatable :: made
+    real(dp) :: e0
+    e0 = abs(r%bal0%total)
+    if (r%restart_step >= 0 .or. .not. r%made_max > 1e-3_dp*max(e0, r%e_scale)) return
+    if (e0 >= 1e-3_dp*r%e_scale) then
+      made = ftoa(100*r%made_max/e0)//'% of the initial energy'
+    else   ! (a scene that starts at rest under its loads)
+      made = rtoa(r%made_max)//' J (the bodies held at most '//rtoa(r%e_scale)//' J)'
+    end if
+    write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
       count_of(r%made_contacts, 'contact', 'contacts')//' active: a node that came into a '// &
       'shell edge-on, through its rim (casca has no edge-to-edge contact), or deep into a '// &
       'target in one step; look at the frames there, or take a shorter dt'
