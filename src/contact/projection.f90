@@ -301,7 +301,7 @@ contains
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     type(constraint_t), intent(inout) :: con
-    real(dp) :: ye(3, 10), p(3), xi(2), shp(10), dphi(10, 2), j(3, 3), f(3), dx(3), det
+    real(dp) :: ye(3, 10), p(3), xi(2), shp(10), dphi(10, 2), j(3, 3), f(3), dx(2), det
     integer :: k, it, nd
     con%xif = con%xi; con%shpf = con%shp
     if (con%elem == 0) return
@@ -316,17 +316,16 @@ contains
       call tri10_shape(xi(1), xi(2), shp, dphi)
       j(:, 1:2) = matmul(ye, dphi); j(:, 3) = con%n
       f = p - matmul(ye, shp)   ! = J [dxi; s] to first order (s enters linearly)
-      f = f - dot_product(f, con%n)*con%n   ! (s itself is not wanted: solve across n only)
       det = dot_product(j(:, 1), cross(j(:, 2), j(:, 3)))
       if (.not. abs(det) > 0) return
-      ! Cramer's rule for the two xi components of J [dxi; ds] = f
+      ! Cramer's rule for the two xi components only (s itself is not wanted)
       dx(1) = dot_product(f, cross(j(:, 2), j(:, 3)))/det
       dx(2) = dot_product(j(:, 1), cross(f, j(:, 3)))/det
-      xi = xi + dx(1:2)
+      xi = xi + dx
       if (min(xi(1), xi(2), 1 - xi(1) - xi(2)) < -0.25_dp) return
-      if (maxval(abs(dx(1:2))) <= 1e-14_dp) exit
+      if (maxval(abs(dx)) <= 1e-14_dp) exit
     end do
-    if (maxval(abs(dx(1:2))) > 1e-12_dp) return
+    if (maxval(abs(dx)) > 1e-12_dp) return
     call tri10_shape(xi(1), xi(2), shp, dphi)
     con%xif = xi; con%shpf = shp
   end subroutine force_point

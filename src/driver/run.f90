@@ -16,7 +16,7 @@ module casca_run
   use casca_step_control, only: step_control_t, local_error, next_step_ratio
   use casca_step_size, only: time_to_contact, same_active_set
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
-                              energy_balance
+                              energy_balance, balance_remainder
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
                           output_flush, output_release, output_indicator_lines
   use casca_vtu_writer, only: field_t, field
@@ -696,14 +696,8 @@ contains
   !> and it may only grow with a dissipative scheme (stay, with a conservative one)
   subroutine watch_energy(r)
     type(run_t), intent(inout) :: r
-    type(energy_term_t), allocatable :: terms(:)
     real(dp) :: rest
-    integer :: k
-    allocate (terms, source=balance_terms(r%deck, r%contact))   ! (so gcc 12 sees it set)
-    rest = r%bal0%total - (r%bal%kinetic + r%bal%strain - r%bal%work)
-    do k = 1, size(terms)
-      rest = rest - terms(k)%value
-    end do
+    rest = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact))
     if (r%st%step > 0 .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t
       r%made_contacts = 0

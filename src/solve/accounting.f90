@@ -13,7 +13,8 @@ module casca_accounting
   use casca_strings, only: rtoa, ftoa
   implicit none
   private
-  public :: balance_t, energy_term_t, account, gravity_load, balance_summary, energy_balance
+  public :: balance_t, energy_term_t, account, gravity_load, balance_summary, energy_balance, &
+            balance_remainder
 
   type :: balance_t
     real(dp) :: kinetic = 0, strain = 0, work = 0, total = 0
@@ -133,6 +134,19 @@ contains
     line = trim(buf)
   end function balance_summary
 
+  !> E0 - (kinetic + strain - work + the extra terms) at state b: what the time integrator
+  !> and the contact removed (energy_balance)
+  pure real(dp) function balance_remainder(b0, b, extra) result(rest)
+    type(balance_t), intent(in) :: b0, b
+    type(energy_term_t), intent(in), optional :: extra(:)
+    integer :: k
+    rest = b0%total - (b%kinetic + b%strain - b%work)
+    if (.not. present(extra)) return
+    do k = 1, size(extra)
+      rest = rest - extra(k)%value
+    end do
+  end function balance_remainder
+
   !> Where the initial energy E0 (b0%total) went by state b: kinetic, strain, minus the work of
   !> the loads, the extra terms given (each an energy taken out of the bodies), and what is
   !> left over, E0 - (kinetic + strain - work + extras): the energy removed by the time
@@ -145,13 +159,12 @@ contains
     character(len=:), allocatable :: line
     real(dp) :: rest
     integer :: k
-    rest = b0%total - (b%kinetic + b%strain - b%work)
+    rest = balance_remainder(b0, b, extra)
     line = 'energy balance: E0 = '//rtoa(b0%total)//' J, kinetic '//rtoa(b%kinetic)//', strain '// &
            rtoa(b%strain)//', work of loads '//rtoa(b%work)
     if (present(extra)) then
       do k = 1, size(extra)
         line = line//', '//extra(k)%name//' '//rtoa(extra(k)%value)
-        rest = rest - extra(k)%value
       end do
     end if
     line = line//', removed by the time integrator and contact '//rtoa(rest)

@@ -56,7 +56,7 @@ contains
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
     allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
-      if (nm%alpha_f > 0) call contact_force_points(contact, model, st%q)   ! (as the last step left them: restarts too)
+      call contact_force_points(contact, model, nm%alpha_f, st%q)   ! (as the last step left them: restarts too)
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
       contact%x_start = positions(model, st%q); contact%dt = dt   ! (friction's slip)
@@ -115,9 +115,9 @@ contains
         call timer_start(t_contact)
         ! the forces as they acted (at the internal force's configuration), then the
         ! correction's impulses where the step ends
-        if (nm%alpha_f > 0) call contact_force_points(contact, model, (1 - nm%alpha_f)*q + nm%alpha_f*st%q)
+        call contact_force_points(contact, model, nm%alpha_f, q, st%q)
         f_end = pair_forces(contact)
-        if (nm%alpha_f > 0) call contact_force_points(contact, model, q)
+        call contact_force_points(contact, model, nm%alpha_f, q)
         if (allocated(nu)) deallocate (nu)
         allocate (nu(contact_nrows(contact)))
         call contact_correction(ls%mass, contact, model, qd, qdd, err, nu)

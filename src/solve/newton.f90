@@ -165,9 +165,7 @@ contains
         call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
                             reproject=reproject)
         nc = contact_nrows(contact)
-        if (present(qn) .and. present(af)) then   ! (where the internal force is taken)
-          if (af > 0) call contact_force_points(contact, model, (1 - af)*q + af*qn)
-        end if
+        if (present(qn) .and. present(af)) call contact_force_points(contact, model, af, q, qn)
         call contact_rows(contact, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, &
                           rows%key, rows%fval)
         version = contact%changes
