@@ -19,7 +19,7 @@ program test_correction
   use casca_contact_active_set, only: contact_update
   use casca_obstacle, only: obstacle_t
   use casca_mass_solver, only: mass_solver_t, mass_setup
-  use casca_contact_correction, only: contact_correction
+  use casca_contact_correction, only: contact_correction, correction_cache_t
   use casca_vectors, only: cross
   use casca_mpi, only: mpi_start, mpi_stop
   use casca_test_rings, only: overlapping_rings
@@ -30,6 +30,7 @@ program test_correction
   type(assembly_t) :: asm
   type(contact_t) :: c
   type(mass_solver_t) :: ms
+  type(correction_cache_t) :: cache
   type(state_t) :: st
   type(balance_t) :: b0, b1
   type(error_t), allocatable :: err
@@ -54,7 +55,7 @@ program test_correction
   call account(model, asm, st, zero, st%q, b0)
   w0 = normal_rates(st%qd)
   allocate (nu(c%nact))
-  call contact_correction(ms, c, model, st%qd, st%qdd, err, nu)
+  call contact_correction(ms, cache, c, model, st%qd, st%qdd, err, nu)
   if (allocated(err)) error stop 'correction'
   call account(model, asm, st, zero, st%q, b1)
   w1 = normal_rates(st%qd); wa = normal_rates(st%qdd)

@@ -6,6 +6,7 @@ answer (an uninterrupted run, the file system, the deck's own numbers).
 usage: test_faults.py CASCA MESH_DIR WORK_DIR
 """
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -125,17 +126,42 @@ ck.record("the folder's lock is gone after the last run", not os.path.exists(os.
 part_out, new_out = os.path.join(work, "part"), os.path.join(work, "moved")
 p = run([casca, "run", deck("part", t_end="5.0e-3", out=part_out), "-q"])
 before = open(os.path.join(part_out, "history.dat")).read()
-p = run([casca, "run", deck("moved", out=part_out), "-q", "--out", new_out,
-         "--restart", os.path.join(part_out, "checkpoint.h5")])
-ck.record("restart into a new folder: exit 0", p.returncode == 0, first_line(p))
-if p.returncode == 0:
-    h = np.loadtxt(os.path.join(new_out, "history.dat"))
-    ok = h.shape == ref.shape
-    ck.le("restart into a new folder: its history.dat vs the uninterrupted run's (max relative to each "
-          "column's size)", np.max(np.abs(h - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300)) if ok
-          else np.inf, 1e-12)
+
+
+def restart_into(name, label, out):
+    """Restart the part run's checkpoint into folder out; record exit 0 and that out's
+    history.dat ends as the uninterrupted run's (1e-12 of each column's size)."""
+    p = run([casca, "run", deck(name, out=part_out), "-q", "--out", out,
+             "--restart", os.path.join(part_out, "checkpoint.h5")])
+    ck.record("%s: exit 0" % label, p.returncode == 0, first_line(p))
+    if p.returncode == 0:
+        h = np.loadtxt(os.path.join(out, "history.dat"))
+        ck.le("%s: its history.dat vs the uninterrupted run's (max relative to each column's size)" % label,
+              np.max(np.abs(h - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300))
+              if h.shape == ref.shape else np.inf, 1e-12)
+    return p.returncode == 0
+
+
+if restart_into("moved", "restart into a new folder", new_out):
     ck.record("restart into a new folder: the checkpoint's folder keeps its history",
               open(os.path.join(part_out, "history.dat")).read() == before)
+
+# --- a restart into a folder that holds another run's results: the history before the
+# checkpoint is the checkpoint folder's, not the folder's own (the stale rows, here the
+# earlier run's scaled by 1.5, were kept as this run's), and run.pvd lists no stale frame
+stale_out = os.path.join(work, "stale")
+shutil.copytree(part_out, stale_out)
+os.remove(os.path.join(stale_out, "checkpoint.h5"))
+with open(os.path.join(stale_out, "history.dat")) as f:
+    head = f.readline()
+rows = np.loadtxt(os.path.join(stale_out, "history.dat"))
+rows[:, 2:] *= 1.5
+np.savetxt(os.path.join(stale_out, "history.dat"), rows, header=head.lstrip("#").strip(), comments="#")
+if restart_into("stale", "restart into a folder of another run", stale_out):
+    pvd = os.path.join(stale_out, "run.pvd")
+    times = [float(t) for t in re.findall(r'timestep="([^"]+)"', open(pvd).read() if os.path.exists(pvd) else "")]
+    ck.record("restart into a folder of another run: run.pvd lists only frames from the restart on "
+              "(t >= 5 ms)", len(times) > 0 and min(times) >= 5.0e-3 * (1 - 1e-9), str(times[:3]))
 
 # --- two runs into one folder: the second is refused (exit 2) while the first runs, and the
 # first ends as if alone (its history equals the uninterrupted run's, no NUL byte)

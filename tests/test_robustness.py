@@ -1,7 +1,7 @@
 """Scenes written by others (issue 14: robustness of Newton, statics, contact, energy).
 
 usage: test_robustness.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR [CASE ...]
-  CASE (default all): shipped slit oblique plate_strike trapezoidal rim
+  CASE (default all): shipped slit oblique plate_strike trapezoidal rim resting
 
 shipped      every deck in examples/ runs to its end with exit 0. test_scenes.py runs
              strip_wall, two_rings and three_rings whole (exit 0 asserted there), and
@@ -40,6 +40,13 @@ rim          a tilted spinning hoop falls past the edge of a free plate (a scene
              warning. Tilted 30 degrees a node enters the plate edge-on (no edge-to-edge
              contact: energy is made): the run's end warning gives the step and its share
              of E0, equal to the history's largest one-step rise (1e-4 s, 1e-3 relative).
+resting      a steel plate (1 m, h 10 mm, 10 x 10 cells) laid 1 um above a rigid plane under
+             gravity, beta 1, gamma 1.5, dt 1e-4 s, 20 steps: it starts held (a = 0), so its
+             first step, before any contact, makes (gamma^2 / 2 - beta) m g^2 dt^2 (Newmark
+             from a = 0 to a = g: v = gamma g dt, the load's path beta g dt^2): the first step's kinetic + strain energy less the loads'
+             work must equal that to 1e-6; every one of its 961 nodes is in contact at the
+             end; and the run must not warn of energy made by contact (it did: 1.2% of the
+             energy the plate held).
 
 Every bound comes from a published table, an analytic answer or a conservation law; none is
 copied from casca's output. Each case prints its wall time (budget for the file: about 4 minutes
@@ -61,7 +68,7 @@ sys.path.insert(0, os.path.join(HERE, "data"))
 import make_slit_annular_plate as slit_mesh  # noqa: E402
 
 casca, examples, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:5]]
-CASES = sys.argv[5:] or ["shipped", "slit", "oblique", "plate_strike", "trapezoidal", "rim"]
+CASES = sys.argv[5:] or ["shipped", "slit", "oblique", "plate_strike", "trapezoidal", "rim", "resting"]
 os.makedirs(work, exist_ok=True)
 ck = Checks()
 STEEL_E, STEEL_NU, STEEL_RHO = 210e9, 0.3, 7700.0
@@ -423,6 +430,27 @@ if "rim" in CASES:
             ck.close("rim30: the warning's figure vs that rise / E0 [%]", float(m.group(2)),
                      100 * rise[k] / h["total"][0], 1e-3)
     timings["rim"] = time.time() - t0
+
+if "resting" in CASES:
+    t0 = time.time()
+    deck = os.path.join(work, "resting.nml")
+    with open(deck, "w") as f:
+        f.write("""&run dt = 1e-4, t_end = 2e-3, gravity = 0.0, 0.0, -9.81, beta = 1.0, gamma = 1.5 /
+&output interval = 2e-3, vtu = .false., plots = .false. /
+&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 10, ny = 10, center = -0.5, -0.5, 0.005001,
+  %s, thickness = 0.01 /
+&obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /
+""" % STEEL)
+    h, ok = run_deck("resting", deck)
+    if h is not None:
+        m, g, dt = STEEL_RHO * 0.01 * 1.0, 9.81, 1e-4
+        made = (h["kinetic"][1] + h["strain"][1]) - (h["kinetic"][0] + h["strain"][0]) - (h["work"][1] - h["work"][0])
+        ck.close("resting: energy the first step made [J] vs (gamma^2 / 2 - beta) m g^2 dt^2",
+                 made, (1.5 ** 2 / 2 - 1.0) * m * g ** 2 * dt ** 2, 1e-6)
+        ck.record("resting: every node of the plate ((3 x 10 + 1)^2 = 961) in contact at the end",
+                  h["contacts"][-1] == 961, str(h["contacts"][-1]))
+    ck.record("resting: no energy warning (stderr)", "warning: the step" not in LAST_STDERR[0], LAST_STDERR[0][-300:])
+    timings["resting"] = time.time() - t0
 
 print("wall time per case: " + ", ".join("%s %.1f s" % kv for kv in timings.items()))
 ck.finish()

@@ -25,7 +25,7 @@ module casca_contact_projection
   implicit none
   private
   public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face, &
-            force_point
+            force_point, row_factors
 
   integer, parameter, public :: max_row = 66   !< 11 nodes x (Y, G)
 
@@ -244,11 +244,40 @@ contains
     m = 11
   end subroutine constraint_entries
 
-  !> Row of C of one constraint as parameters d(1:nd) and values v(1:nd). kind 0: the
-  !> normal row, the mid-surface points along n and, between faces, the fibres that carry the
-  !> offset; kind 1, 2: the stick rows along t1, t2; kind 3: along the slip direction s (the
-  !> sliding force's, mu_d |lambda| on it). force: the normal row as the force acts, at
-  !> shpf; the same parameters in the same order as the gap's row.
+  !> Row of C of one constraint as a scalar row over the nodes' vector parameters times a
+  !> direction: C_row = sum_j w(j) e(node(j), par(j)) (x) dir, par 0 the mid-surface point Y,
+  !> 1 the fibre G (the Y entries first). kind 0: the normal row, the mid-surface points
+  !> along n and, between faces, the fibres that carry the offset; kind 1, 2: the stick rows
+  !> along t1, t2; kind 3: along the slip direction s (the sliding force's, mu_d |lambda| on
+  !> it). force: the normal row as the force acts, at shpf. (The correction's mass solves
+  !> need the scalar row only: one column per row, not one per component.)
+  pure subroutine row_factors(a, model, kind, force, node, par, w, nw, dir)
+    type(constraint_t), intent(in) :: a
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: kind
+    logical, intent(in) :: force
+    integer, intent(out) :: node(2*11), par(2*11), nw
+    real(dp), intent(out) :: w(2*11), dir(3)
+    integer :: j, nn
+    select case (kind)
+    case (0); dir = a%n
+    case (1, 2); dir = a%t(:, kind)
+    case default; dir = a%s
+    end select
+    call constraint_entries(a, model, node(1:11), w(1:11), nn, force .and. kind == 0)
+    par(1:nn) = 0
+    nw = nn
+    if (kind /= 0 .or. all(a%wg == 0)) return
+    do j = 1, nn
+      if (merge(a%wg(1), a%wg(2), j == 1) == 0) cycle   ! (so the pattern follows wg only)
+      nw = nw + 1; node(nw) = node(j); par(nw) = 1
+      w(nw) = merge(a%wg(1), -w(j)*a%wg(2), j == 1)   ! (-w(j) = N_j on the target)
+    end do
+  end subroutine row_factors
+
+  !> Row of C of one constraint (row_factors) as parameters d(1:nd) and values v(1:nd): the
+  !> mid-surface points' components first, then the fibres' node by node, so that rows of
+  !> one constraint list the same parameters in the same order.
   pure subroutine constraint_row(a, model, d, v, nd, kind, force)
     type(constraint_t), intent(in) :: a
     type(model_t), intent(in) :: model
@@ -256,31 +285,24 @@ contains
     real(dp), intent(out) :: v(max_row)
     integer, intent(in), optional :: kind
     logical, intent(in), optional :: force
-    integer :: j, comp, nodes(11), nn, kd
-    real(dp) :: w(11), wf, dir(3)
+    integer :: j, comp, node(22), par(22), nw, ny, kd
+    real(dp) :: w(22), dir(3)
     logical :: at_force
     kd = 0
     if (present(kind)) kd = kind
     at_force = .false.
-    if (present(force)) at_force = force .and. kd == 0
-    select case (kd)
-    case (0); dir = a%n
-    case (1, 2); dir = a%t(:, kd)
-    case default; dir = a%s
-    end select
+    if (present(force)) at_force = force
+    call row_factors(a, model, kd, at_force, node, par, w, nw, dir)
+    ny = count(par(1:nw) == 0)
     nd = 0
-    call constraint_entries(a, model, nodes, w, nn, at_force)
     do comp = 1, 3
-      do j = 1, nn
-        nd = nd + 1; d(nd) = dof(nodes(j), comp); v(nd) = w(j)*dir(comp)
+      do j = 1, ny
+        nd = nd + 1; d(nd) = dof(node(j), comp); v(nd) = w(j)*dir(comp)
       end do
     end do
-    if (kd /= 0 .or. all(a%wg == 0)) return
-    do j = 1, nn
-      if (merge(a%wg(1), a%wg(2), j == 1) == 0) cycle   ! (so the pattern follows wg only)
-      wf = merge(a%wg(1), -w(j)*a%wg(2), j == 1)   ! (-w(j) = N_j on the target)
+    do j = ny + 1, nw
       do comp = 1, 3
-        nd = nd + 1; d(nd) = dof(nodes(j), 3 + comp); v(nd) = wf*dir(comp)
+        nd = nd + 1; d(nd) = dof(node(j), 3 + comp); v(nd) = w(j)*dir(comp)
       end do
     end do
   end subroutine constraint_row

@@ -65,6 +65,9 @@ module casca_run
     real(dp) :: rest_last = 0, made_max = 0, t_made = 0
     real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
     integer :: made_contacts = 0
+    !> a body under gravity starts held by its contact (a = 0): its first step makes energy
+    !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact: not watched
+    logical :: held_at_start = .false.
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
     type(error_t), allocatable :: err
@@ -497,7 +500,7 @@ contains
   !> under a point load.)
   subroutine start_acceleration(r)
     type(run_t), intent(inout) :: r
-    logical :: falls(r%model%nbody)
+    logical :: falls(r%model%nbody), falling(r%model%nbody)
     integer :: b, n
     associate (model => r%model, st => r%st)
       do b = 1, model%nbody
@@ -506,7 +509,11 @@ contains
                      .not. any(model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7)))
         end associate
       end do
-      if (allocated(r%contact)) call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls)
+      if (allocated(r%contact)) then
+        falling = falls
+        call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls)
+        r%held_at_start = any(falling .and. .not. falls)
+      end if
       do b = 1, model%nbody
         if (.not. falls(b)) cycle
         do n = model%body(b)%node_first, model%body(b)%node_last
@@ -698,7 +705,7 @@ contains
     type(run_t), intent(inout) :: r
     real(dp) :: rest
     rest = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact))
-    if (r%st%step > 0 .and. r%rest_last - rest > r%made_max) then
+    if (r%st%step > merge(1, 0, r%held_at_start) .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t
       r%made_contacts = 0
       if (allocated(r%contact)) r%made_contacts = r%contact%nact

@@ -24,7 +24,7 @@ module casca_output
                          kind_regular
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
-  use casca_output_lock, only: lock_folder, unlock_folder
+  use casca_output_lock, only: lock_folder, unlock_folder, locked_here
   use casca_mesh_indicator, only: indicator_t, mesh_indicator, indicator_lines, indicator_line_len
   implicit none
   private
@@ -118,6 +118,7 @@ contains
     character(len=:), allocatable :: note, earlier
     integer :: ios
     character(len=256) :: msg
+    logical :: own
 
     out%dir = trim(dir)
     out%tracked = tracked
@@ -134,10 +135,20 @@ contains
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
     cols = history_columns(size(tracked), bodies, pairs, friction, moving)
-    ! a restart into a new folder carries on the checkpoint folder's history (its frames stay
-    ! there); with none at all, the history starts at the restart
+    ! a restart carries on the checkpoint folder's history (into another folder its frames
+    ! stay there): what the other folder held is not taken while the checkpoint's folder has a
+    ! history (another run's rows were kept as this run's); with none there, the folder's own
+    ! (a checkpoint copied away from its results); with none at all, the history starts anew
+    own = .true.
+    if (present(restart_dir)) own = locked_here(restart_dir)
     earlier = out%dir//'/history.dat'
-    if (file_kind(earlier) == kind_missing .and. present(restart_dir)) earlier = restart_dir//'/history.dat'
+    if (.not. own) then
+      if (file_kind(restart_dir//'/history.dat') /= kind_missing) then
+        earlier = restart_dir//'/history.dat'
+      else
+        own = .true.
+      end if
+    end if
     if (restart_step < 0 .or. file_kind(earlier) == kind_missing) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return
@@ -151,7 +162,7 @@ contains
     else
       call keep_history(out, cols, restart_step, earlier, err)
       if (allocated(err)) return
-      call keep_frames(restart_time, err)
+      if (own) call keep_frames(restart_time, err)
     end if
   contains
     !> the frames of the earlier run.pvd with time <= tmax

@@ -10,7 +10,7 @@ module casca_output_lock
   use casca_strings, only: itoa
   implicit none
   private
-  public :: lock_folder, unlock_folder
+  public :: lock_folder, unlock_folder, locked_here
 
   character(len=*), parameter :: lock_name = '/casca.lock'
 
@@ -68,6 +68,13 @@ contains
     character(len=*), intent(in) :: dir
     if (holder(dir) == c_getpid()) call delete_file(dir//lock_name)
   end subroutine unlock_folder
+
+  !> Whether this process holds dir's lock: dir is the folder this run writes, however the
+  !> two paths are spelled
+  logical function locked_here(dir)
+    character(len=*), intent(in) :: dir
+    locked_here = holder(dir) == c_getpid()
+  end function locked_here
 
   !> got: the lock file was created and holds this process's id
   subroutine try_lock(dir, got, err)

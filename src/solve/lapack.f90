@@ -1,11 +1,19 @@
-!> Explicit interfaces of the few LAPACK routines casca calls (the library ships none).
+!> Explicit interfaces of the few LAPACK and BLAS routines casca calls (the libraries ship
+!> none).
 module casca_lapack
   use casca_kinds, only: dp
   implicit none
   private
-  public :: dsyev, dpotrf, dpotrs, dgetrf, dgetrs
+  public :: dsyev, dpotrf, dpotrs, dgetrf, dgetrs, dgemm
 
   interface
+    subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+      import :: dp
+      character, intent(in) :: transa, transb
+      integer, intent(in) :: m, n, k, lda, ldb, ldc
+      real(dp), intent(in) :: alpha, beta, a(lda, *), b(ldb, *)
+      real(dp), intent(inout) :: c(ldc, *)
+    end subroutine dgemm
     subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
       import :: dp
       character, intent(in) :: jobz, uplo

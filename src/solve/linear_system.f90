@@ -16,6 +16,7 @@ module casca_linear_system
   use casca_schur, only: schur_t, schur_match, schur_store, schur_apply
   use casca_solver_choice, only: solver_choice_t, choose_solver
   use casca_mass_solver, only: mass_solver_t
+  use casca_contact_correction, only: correction_cache_t
   use casca_metis, only: nested_dissection
   use casca_mpi, only: sum_all, share_error
   implicit none
@@ -46,6 +47,7 @@ module casca_linear_system
     type(schur_t) :: cache                     !< Z and S of the Schur path
     integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
     type(mass_solver_t) :: mass                !< M by component, for the contact correction
+    type(correction_cache_t) :: correction     !< its last C M^-1 C^T, factorised
   contains
     procedure :: finish => system_finish
     procedure :: drop_factors => system_drop_factors

@@ -36,7 +36,7 @@ module casca_mass_solver
     integer :: solver_of(3) = [1, 2, 3]  !< components with the same restraints share one
     type(column_cache_t) :: cache(3)     !< per system
   contains
-    procedure :: solve_sparse => mass_solve_sparse
+    procedure :: columns => mass_columns
     procedure :: finish => mass_finish
   end type mass_solver_t
 
@@ -99,62 +99,90 @@ contains
     end function param_dof
   end subroutine mass_setup
 
-  !> x = m^-1 b for system s (b, x: (its neq, nrhs)), b with few nonzero rows: x = sum_i b(i, :) M^-1 e_i,
-  !> the columns missing from the cache solved at once and kept
-  subroutine mass_solve_sparse(self, s, b, x, err)
+  !> x(:, 1:ncol) = m^-1 G for system s, G sparse by columns (ptr(ncol + 1), its equations
+  !> idx and values val; a few nonzeros each): x = sum val M^-1 e_idx, the columns missing
+  !> from the cache solved at once and kept. x is the caller's, grown when too small (never
+  !> shrunk): a contact patch that stays costs no allocation.
+  subroutine mass_columns(self, s, ptr, idx, val, x, err)
     class(mass_solver_t), intent(inout) :: self
-    integer, intent(in) :: s
-    real(dp), intent(in) :: b(:, :)
-    real(dp), intent(out) :: x(:, :)
+    integer, intent(in) :: s, ptr(:), idx(:)
+    real(dp), intent(in) :: val(:)
+    real(dp), allocatable, intent(inout) :: x(:, :)
     type(error_t), allocatable, intent(out) :: err
-    integer, allocatable :: rows(:), missing(:)
+    integer :: n, j, k, ncol
+    n = self%neq(s); ncol = size(ptr) - 1
+    call cache_columns(self, s, idx, err)
+    if (allocated(err)) return
+    if (allocated(x)) then
+      if (size(x, 1) /= n .or. size(x, 2) < ncol) deallocate (x)
+    end if
+    if (.not. allocated(x)) allocate (x(n, ncol))
+    associate (c => self%cache(s))
+      do j = 1, ncol
+        x(:, j) = 0
+        do k = ptr(j), ptr(j + 1) - 1
+          x(:, j) = x(:, j) + val(k)*c%col(:, c%slot(idx(k)))
+        end do
+      end do
+    end associate
+  end subroutine mass_columns
+
+  !> Make sure the cache of system s holds M^-1 e_i for every equation i in idx (a full
+  !> cache is emptied, not grown: the equations asked for now are solved again)
+  subroutine cache_columns(self, s, idx, err)
+    class(mass_solver_t), intent(inout) :: self
+    integer, intent(in) :: s, idx(:)
+    type(error_t), allocatable, intent(out) :: err
+    integer, allocatable :: missing(:)
     real(dp), allocatable :: e(:, :), z(:, :)
-    integer :: n, i, j, k, cap
+    integer :: n, k, m, cap
     n = self%neq(s)
+    cap = max(64, cache_bytes/(8*max(n, 1)))
     associate (c => self%cache(s))
       if (.not. allocated(c%slot)) then
         allocate (c%slot(n), c%col(n, 0))
         c%slot = 0
       end if
-      rows = pack([(i, i=1, n)], any(b /= 0, dim=2))
-      missing = pack(rows, c%slot(rows) == 0)
-      if (size(missing) > 0) then
-        cap = max(64, cache_bytes/(8*max(n, 1)))
-        if (c%n + size(missing) > cap) then   ! full: start again
-          c%slot = 0; c%n = 0
-          missing = rows
+      allocate (missing(size(idx)))
+      do
+        m = 0
+        do k = 1, size(idx)   ! (marked -1 while listed: each equation once)
+          if (c%slot(idx(k)) /= 0) cycle
+          m = m + 1; missing(m) = idx(k); c%slot(idx(k)) = -1
+        end do
+        if (c%n + m <= cap) exit
+        if (c%n == 0) then   ! more than a full cache's worth at once: hold them all
+          cap = m; exit
         end if
-        allocate (e(n, size(missing)), z(n, size(missing)))
-        e = 0
-        do k = 1, size(missing)
-          e(missing(k), k) = 1
-        end do
-        call self%m(s)%solve(e, z, err)
-        if (allocated(err)) return
-        if (size(c%col, 2) < c%n + size(missing)) call grow(c%n + size(missing))
-        do k = 1, size(missing)
-          c%n = c%n + 1
-          c%slot(missing(k)) = c%n
-          c%col(:, c%n) = z(:, k)
-        end do
+        c%slot = 0; c%n = 0   ! full: start again
+      end do
+      if (m == 0) return
+      allocate (e(n, m), z(n, m))
+      e = 0
+      do k = 1, m
+        e(missing(k), k) = 1
+      end do
+      call self%m(s)%solve(e, z, err)
+      if (allocated(err)) then
+        c%slot(missing(1:m)) = 0
+        return
       end if
-      x = 0
-      do k = 1, size(rows)
-        i = rows(k)
-        do j = 1, size(b, 2)
-          if (b(i, j) /= 0) x(:, j) = x(:, j) + b(i, j)*c%col(:, c%slot(i))
-        end do
+      if (size(c%col, 2) < c%n + m) call grow(c%n + m)
+      do k = 1, m
+        c%n = c%n + 1
+        c%slot(missing(k)) = c%n
+        c%col(:, c%n) = z(:, k)
       end do
     end associate
   contains
     subroutine grow(need)
       integer, intent(in) :: need
       real(dp), allocatable :: t(:, :)
-      allocate (t(n, min(max(2*need, 16), max(64, cache_bytes/(8*max(n, 1))))))
+      allocate (t(n, min(max(2*need, 16), cap)))
       t(:, 1:self%cache(s)%n) = self%cache(s)%col(:, 1:self%cache(s)%n)
       call move_alloc(t, self%cache(s)%col)
     end subroutine grow
-  end subroutine mass_solve_sparse
+  end subroutine cache_columns
 
   subroutine mass_finish(self)
     class(mass_solver_t), intent(inout) :: self

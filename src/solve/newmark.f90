@@ -120,7 +120,7 @@ contains
         call contact_force_points(contact, model, nm%alpha_f, q)
         if (allocated(nu)) deallocate (nu)
         allocate (nu(contact_nrows(contact)))
-        call contact_correction(ls%mass, contact, model, qd, qdd, err, nu)
+        call contact_correction(ls%mass, ls%correction, contact, model, qd, qdd, err, nu)
         call timer_stop(t_contact)
         if (allocated(err)) return
       end if
