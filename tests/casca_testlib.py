@@ -87,3 +87,18 @@ def deck_variant(src, dst, **changes):
     with open(dst, "w") as f:
         f.write(text)
     return dst
+
+
+def spinning_plate_deck(solver, run_extra=""):
+    """A steel plate (1 m, h 10 mm, 9 x 9 cells) thrown at 0.2 m/s, spinning, onto a rigid
+    plane under 100 m/s^2: several hundred contacts changing from step to step, 5 steps.
+    solver: &contact solver; run_extra: more &run settings (', key = value')."""
+    return """&run dt = 1e-4, t_end = 5e-4, gravity = 0.0, 0.0, -100.0%s /
+&output interval = 5e-4, vtu = .false., plots = .false.,
+  track = 0.5, 0.5, 0.0,  -0.5, -0.5, 0.0,  0.0, 0.0, 0.0 /
+&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 9, ny = 9,
+  center = -0.5, -0.5, 0.005001, velocity = 0.0, 0.0, -0.2, omega = 0.5, 0.3, 0.0,
+  young = 210e9, poisson = 0.3, density = 7800, thickness = 0.01 /
+&obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /
+&contact solver = '%s' /
+""" % (run_extra, solver)

@@ -18,25 +18,15 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, run, run_scene
+from casca_testlib import Checks, history, run, run_scene, spinning_plate_deck
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
 os.makedirs(work, exist_ok=True)
 ck = Checks()
 
-DECK = """&run dt = 1e-4, t_end = 5e-4, gravity = 0.0, 0.0, -100.0 /
-&output interval = 5e-4, vtu = .false., plots = .false.,
-  track = 0.5, 0.5, 0.0,  -0.5, -0.5, 0.0,  0.0, 0.0, 0.0 /
-&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 9, ny = 9,
-  center = -0.5, -0.5, 0.005001, velocity = 0.0, 0.0, -0.2, omega = 0.5, 0.3, 0.0,
-  young = 210e9, poisson = 0.3, density = 7800, thickness = 0.01 /
-&obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /
-&contact solver = '%s' /
-"""
-
 runs = {}
 for solver in ("schur", "saddle", "auto"):
-    out, _ = run_scene(casca, ck, work, solver, DECK % solver)
+    out, _ = run_scene(casca, ck, work, solver, spinning_plate_deck(solver))
     runs[solver] = history(out) if out else None
 
 ref = runs["schur"]
@@ -64,8 +54,8 @@ if ref is not None:
 # --- bad value
 deck = os.path.join(work, "fast.nml")
 with open(deck, "w") as f:
-    f.write(DECK % "fast")
-line = 1 + (DECK % "fast").splitlines().index("&contact solver = 'fast' /")
+    f.write(spinning_plate_deck("fast"))
+line = 1 + spinning_plate_deck("fast").splitlines().index("&contact solver = 'fast' /")
 p = run([casca, "check", deck])
 ck.record("solver = 'fast': exit 2 naming the file, the line and the field",
           p.returncode == 2 and ("fast.nml:%d:" % line) in p.stderr and "&contact: solver" in p.stderr,

@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, run
+from casca_testlib import Checks, history, run, spinning_plate_deck
 
 casca, examples, work = [os.path.abspath(a) for a in sys.argv[1:4]]
 os.makedirs(work, exist_ok=True)
@@ -75,24 +75,15 @@ for np_ranks in (1, 2):
     compare("rings, %d rank(s), single" % np_ranks, h, ref, 4e-9, 0.02)
 
 # --- the saddle-point matrix in single precision
-PLATE = """&run dt = 1e-4, t_end = 5e-4, gravity = 0.0, 0.0, -100.0%s /
-&output interval = 5e-4, vtu = .false., plots = .false.,
-  track = 0.5, 0.5, 0.0,  -0.5, -0.5, 0.0,  0.0, 0.0, 0.0 /
-&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 9, ny = 9,
-  center = -0.5, -0.5, 0.005001, velocity = 0.0, 0.0, -0.2, omega = 0.5, 0.3, 0.0,
-  young = 210e9, poisson = 0.3, density = 7800, thickness = 0.01 /
-&obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /
-&contact solver = 'saddle' /
-"""
-ref = run_deck("plate_double", PLATE % "")
-h = run_deck("plate_single", PLATE % ", factor_precision = 'single'")
+ref = run_deck("plate_double", spinning_plate_deck("saddle"))
+h = run_deck("plate_single", spinning_plate_deck("saddle", ", factor_precision = 'single'"))
 if ref is not None:
     ck.record("plate_double: several hundred contacts", ref["contacts"][1:].min() >= 400,
               "%d" % ref["contacts"][1:].min())
 compare("plate, saddle, single", h, ref, 1e-9, 0.1)
 
 # --- bad value
-text = PLATE % ", factor_precision = 'half'"
+text = spinning_plate_deck("saddle", ", factor_precision = 'half'")
 deck = os.path.join(work, "half.nml")
 with open(deck, "w") as f:
     f.write(text)

@@ -118,7 +118,7 @@ contains
       if (c%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
                              -con%n, con%face(1), con%off, con%wg(1))
       con%gap = gm - con%off
-      call hold_force_point()
+      call hold_force_point(con)
       call friction_geometry()
       return
     end if
@@ -165,14 +165,9 @@ contains
       con%wg(2) = -con%wg(2)
     end if
     con%gap = con%side*gm - con%off
-    call hold_force_point()
+    call hold_force_point(con)
     call friction_geometry()
   contains
-    !> the force acts at the gap's point until force_point finds its own
-    subroutine hold_force_point()
-      con%xif = con%xi; con%shpf = con%shp
-    end subroutine hold_force_point
-
     !> tangents (the first kept from the last, turned across n) and the relative tangential
     !> displacement of the node over the step
     subroutine friction_geometry()
@@ -325,7 +320,7 @@ contains
     type(constraint_t), intent(inout) :: con
     real(dp) :: ye(3, 10), p(3), xi(2), shp(10), dphi(10, 2), j(3, 3), f(3), dx(2), det
     integer :: k, it, nd
-    con%xif = con%xi; con%shpf = con%shp
+    call hold_force_point(con)
     if (con%elem == 0) return
     do k = 1, 10
       nd = model%conn(k, con%elem)
@@ -351,6 +346,12 @@ contains
     call tri10_shape(xi(1), xi(2), shp, dphi)
     con%xif = xi; con%shpf = shp
   end subroutine force_point
+
+  !> The force acts at the gap's point until force_point finds its own
+  pure subroutine hold_force_point(con)
+    type(constraint_t), intent(inout) :: con
+    con%xif = con%xi; con%shpf = con%shp
+  end subroutine hold_force_point
 
   !> Unit normal of the cubic surface with node positions xe where the shape derivatives are dphi
   pure function unit_normal(xe, dphi) result(n)

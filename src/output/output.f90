@@ -135,19 +135,15 @@ contains
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
     cols = history_columns(size(tracked), bodies, pairs, friction, moving)
-    ! a restart carries on the checkpoint folder's history (into another folder its frames
-    ! stay there): what the other folder held is not taken while the checkpoint's folder has a
-    ! history (another run's rows were kept as this run's); with none there, the folder's own
-    ! (a checkpoint copied away from its results); with none at all, the history starts anew
-    own = .true.
-    if (present(restart_dir)) own = locked_here(restart_dir)
+    ! a restart carries on the checkpoint folder's history, and into another folder leaves
+    ! its frames there: what the other folder held is not taken (another run's rows were kept
+    ! as this run's) unless the checkpoint's folder has no history (a checkpoint copied away
+    ! from its results); with none at all, the history starts anew
     earlier = out%dir//'/history.dat'
-    if (.not. own) then
-      if (file_kind(restart_dir//'/history.dat') /= kind_missing) then
-        earlier = restart_dir//'/history.dat'
-      else
-        own = .true.
-      end if
+    own = .true.
+    if (present(restart_dir)) then
+      own = locked_here(restart_dir) .or. file_kind(restart_dir//'/history.dat') == kind_missing
+      if (.not. own) earlier = restart_dir//'/history.dat'
     end if
     if (restart_step < 0 .or. file_kind(earlier) == kind_missing) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
