@@ -12,12 +12,14 @@ module casca_timers
   character(len=*), parameter :: names(ntimers) = [character(len=13) :: 'elements', &
     'contact', 'analysis', 'factorisation', 'solution', 'accounting', 'output']
   real(dp) :: total(ntimers) = 0, started(ntimers) = 0
+  integer :: calls(ntimers) = 0
 
 contains
 
   subroutine timer_start(i)
     integer, intent(in) :: i
     started(i) = wall_time()
+    calls(i) = calls(i) + 1
   end subroutine timer_start
 
   subroutine timer_stop(i)
@@ -25,7 +27,8 @@ contains
     total(i) = total(i) + wall_time() - started(i)
   end subroutine timer_stop
 
-  !> One line: seconds in each part and the share of the given wall time.
+  !> One line: seconds in each part and the share of the given wall time (with how many
+  !> times for the factorisations: what a new step length or contact set costs)
   function timer_report(wall) result(s)
     real(dp), intent(in) :: wall
     character(len=:), allocatable :: s
@@ -33,7 +36,9 @@ contains
     integer :: i
     s = 'time:'
     do i = 1, ntimers
-      write (b, '(a,i0,a)') ' s (', nint(100*total(i)/max(wall, tiny(1._dp))), '%)'
+      write (b, '(a,i0,a)') ' s (', nint(100*total(i)/max(wall, tiny(1._dp))), '%'
+      if (i == t_factor) write (b, '(a,a,i0,a)') trim(b), ', ', calls(i), ' times'
+      b = trim(b)//')'
       s = s//' '//trim(names(i))//' '//seconds(total(i))//trim(b)
       if (i < ntimers) s = s//','
     end do

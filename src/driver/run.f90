@@ -14,7 +14,7 @@ module casca_run
   use casca_newmark, only: state_t, newmark_step, static_solve
   use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
   use casca_step_control, only: step_control_t, local_error, next_step_ratio
-  use casca_step_size, only: time_to_contact, same_active_set
+  use casca_step_size, only: time_to_contact
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance, balance_remainder
   use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
@@ -58,7 +58,6 @@ module casca_run
     type(scheme_t) :: nm                        !< the time integration scheme
     type(step_control_t) :: sc                  !< steps by an error estimate (tol > 0)
     real(dp) :: dt_try = 0                      !< with sc: the next step's length
-    logical :: landing = .false.                !< this step ends at a predicted contact
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
     !> the energy a step made (the remainder of the balance fell): the largest, when, and the
     !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
@@ -297,7 +296,7 @@ contains
       allocate (r%frozen(model%ndof), r%idle(model%nbody))
       r%frozen = .false.; r%idle = .false.
       do while (st%t < deck%run%t_end - 1e-6_dp*dt)
-        nm%dt = step_length(r, next_frame)
+        nm%dt = step_length(r, interval)
         if (deck%run%skip_idle_bodies) call update_frozen(r)
         if (allocated(r%err)) then
           call give_up(r, r%err%message); return
@@ -388,54 +387,68 @@ contains
     call finish(r)
   end subroutine static_run
 
-  !> The next step: the deck's dt halved level times, or with the error control the length it
-  !> chose, ended at the next frame and at the predicted time of first contact
-  real(dp) function step_length(r, next_frame) result(h)
+  !> The next step: the deck's dt halved level times, or with the error control the frame
+  !> interval halved as often as dt_try asks, on that length's grid from t = 0 (a step off
+  !> the grid, after a landing, first returns to it): the steps of a level follow each other
+  !> with the same factors and land on every frame. A step is ended at the predicted time of
+  !> first contact.
+  real(dp) function step_length(r, interval) result(h)
     type(run_t), intent(inout) :: r
-    real(dp), intent(in) :: next_frame
+    real(dp), intent(in) :: interval
     real(dp) :: hit
     associate (st => r%st, t_end => r%deck%run%t_end)
       if (r%sc%tol <= 0) then
         h = min(r%deck%run%dt/2**r%level, t_end - st%t)
         return
       end if
-      ! equal steps to the next frame (or the end): no sliver of a step before it
-      h = max(min(next_frame, t_end) - st%t, r%sc%dt_min)
-      h = h/ceiling(h/r%dt_try - 1e-9_dp)
-      r%landing = .false.
+      h = interval/2._dp**max(0, ceiling(log(interval/r%dt_try)/log(2._dp) - 1e-9_dp))
+      h = min((floor(st%t/h + 1e-9_dp) + 1)*h - st%t, t_end - st%t)
       if (.not. allocated(r%contact)) return
       r%contact%time = st%t
       hit = time_to_contact(r%contact, r%model, st%q, st%qd, h)
-      if (hit < h) then
-        h = max(hit, r%sc%dt_min)
-        r%landing = .true.
+      ! (a touch at the step's start, where the last step ended, is no landing: a sliver of a
+      ! step would stop the node in it, a force of m v / sliver)
+      if (hit < h .and. hit > r%sc%dt_min) then
+        h = hit
       end if
     end associate
   end function step_length
 
-  !> With the error control: is the step just taken within the tolerance (or below the
-  !> shortest step, or one whose contact set changed)? Sets the next step's length.
+  !> With the error control: is the step just taken within the tolerance (or at the shortest
+  !> step)? Sets the next step's length.
   logical function step_accepted(r, before, contact_before) result(ok)
     type(run_t), intent(inout) :: r
     type(state_t), intent(in) :: before
     type(contact_t), intent(in), optional :: contact_before
     real(dp) :: err, ratio, h
-    logical :: same
+    logical, allocatable :: skip(:)
     h = r%nm%dt
-    err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd)
+    ! the contact's nodes (impactor and target element, at either end) are left out: their
+    ! acceleration jumps where a contact starts or ends, whatever the step
+    allocate (skip(r%model%nnode))
+    skip = .false.
+    if (present(contact_before)) then
+      call touching(contact_before)
+      call touching(r%contact)
+    end if
+    err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd, skip)
     ratio = next_step_ratio(r%sc, err)
-    same = .true.
-    if (present(contact_before)) same = same_active_set(contact_before, r%contact)
-    ok = err <= 1 .or. h <= r%sc%dt_min .or. .not. same
-    ! (a step ended early by a frame or a contact, within the tolerance, does not shorten
-    ! dt_try; it may lengthen it: steps made equal to a frame are all a little short)
-    if (ok .and. ratio >= 1) then
+    ok = err <= 1 .or. h <= r%sc%dt_min
+    if (ok .and. ratio >= 1) then   ! (a step cut short by a frame or the grid does not shorten it)
       r%dt_try = max(r%dt_try, h*ratio)
     else
       r%dt_try = max(h*ratio, r%sc%dt_min)
     end if
-    ! past an onset the contact sets the pace: the deck's dt, grown as the error allows
-    if (r%landing .or. .not. same) r%dt_try = min(r%dt_try, r%deck%run%dt)
+  contains
+    !> mark the nodes of c's active constraints: the impactor's and its target element's
+    subroutine touching(c)
+      type(contact_t), intent(in) :: c
+      integer :: k
+      do k = 1, c%nact
+        skip(c%act(k)%node) = .true.
+        if (c%act(k)%elem > 0) skip(r%model%conn(:, c%act(k)%elem)) = .true.
+      end do
+    end subroutine touching
   end function step_accepted
 
   !> Leave the bodies that need no solving this step out of the equations (re-analysed

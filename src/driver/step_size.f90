@@ -1,7 +1,6 @@
-!> What the error-controlled step (casca_run's step_length and step_accepted) asks of the
-!> contact: the predicted time of first contact, at which a step is ended so that the onset
-!> is not stepped over, and whether a step changed the active set (such a step is not taken
-!> again for its error).
+!> What the error-controlled step (casca_run's step_length) asks of the contact: the
+!> predicted time of first contact, at which a step is ended so that the onset is not
+!> stepped over.
 module casca_step_size
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
@@ -10,7 +9,7 @@ module casca_step_size
   use casca_free_flight, only: clear_near_contact
   implicit none
   private
-  public :: time_to_contact, same_active_set
+  public :: time_to_contact
 
 contains
 
@@ -48,17 +47,4 @@ contains
       i = [((dof(n, m), m=first, first + 2), n=1, model%nnode)]
     end function idx
   end function time_to_contact
-
-  !> The same constraints (node and pair) before and after a step
-  pure logical function same_active_set(a, b)
-    type(contact_t), intent(in) :: a, b
-    integer :: k
-    same_active_set = a%nact == b%nact
-    if (.not. same_active_set) return
-    do k = 1, a%nact
-      same_active_set = any(b%act(1:b%nact)%node == a%act(k)%node .and. &
-                            b%act(1:b%nact)%pair == a%act(k)%pair)
-      if (.not. same_active_set) return
-    end do
-  end function same_active_set
 end module casca_step_size

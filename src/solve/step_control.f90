@@ -2,10 +2,12 @@
 !> estimated from the change of acceleration over it (casca_time_scheme's error_coefficient,
 !> Zienkiewicz & Xie 1991), as a length per node (the mid-surface point's, and the fibre's
 !> times half the thickness: the faces' motion), against tolerance times the scene's size.
+!> The nodes of active contacts are left out (the caller's skip): their acceleration jumps
+!> where a contact starts or ends, a jump the velocity correction takes, not the step.
 !> The local error is O(dt^3), so the next step is dt (safety / err)^(1/3), within a growth
-!> and a shrink limit; a step whose error is above 1 is taken again shorter, except where the
-!> contact set changed in it (the velocity jumps there whatever the step: the step is ended
-!> at the predicted time of contact instead, casca_run).
+!> and a shrink limit; a step whose error is above 1 is taken again shorter (casca_run, which
+!> also ends steps at a predicted contact and rounds the length down to the frame interval
+!> over a power of 2).
 module casca_step_control
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
@@ -20,23 +22,24 @@ module casca_step_control
     real(dp) :: safety = 0.9_dp
     real(dp) :: grow = 2          !< at most this growth from one step to the next
     real(dp) :: shrink = 0.2_dp   !< at least this factor when a step is taken again
-    real(dp) :: keep = 1.5_dp     !< growths below this keep dt (a new dt is a new matrix)
     real(dp) :: dt_min = 0        !< below this no step is rejected for its error
   end type step_control_t
 
 contains
 
   !> The step's estimated local error over the tolerance: max over the free nodes of
-  !> c dt^2 |a1 - a0| (Y; G times h/2) / (tol length)
-  function local_error(sc, ts, model, a0, a1) result(err)
+  !> c dt^2 |a1 - a0| (Y; G times h/2) / (tol length), skipping the nodes marked in skip
+  function local_error(sc, ts, model, a0, a1, skip) result(err)
     type(step_control_t), intent(in) :: sc
     type(scheme_t), intent(in) :: ts
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: a0(:), a1(:)
+    logical, intent(in) :: skip(:)
     real(dp) :: err, e, h
     integer :: n, i
     e = 0
     do n = 1, model%nnode
+      if (skip(n)) cycle
       i = dof(n, 1)
       h = 0.5_dp*model%body(model%node_body(n))%thickness
       e = max(e, norm2(a1(i:i + 2) - a0(i:i + 2)), h*norm2(a1(i + 3:i + 5) - a0(i + 3:i + 5)))
@@ -44,11 +47,10 @@ contains
     err = ts%error_coefficient()*ts%dt**2*e/(sc%tol*sc%length)
   end function local_error
 
-  !> The factor of the next step from the error of the last (1: keep it)
+  !> The factor of the next step from the error of the last
   pure real(dp) function next_step_ratio(sc, err) result(ratio)
     type(step_control_t), intent(in) :: sc
     real(dp), intent(in) :: err
     ratio = min(sc%grow, max(sc%shrink, sc%safety*max(err, tiny(1._dp))**(-1/3._dp)))
-    if (ratio >= 1 .and. ratio < sc%keep) ratio = 1
   end function next_step_ratio
 end module casca_step_control
