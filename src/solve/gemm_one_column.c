@@ -51,35 +51,22 @@ static int one_column(const char *ta, const char *tb, const int *m, const int *n
     return 1;
 }
 
-void dgemm_(const char *ta, const char *tb, const int *m, const int *n, const int *k,
-            const double *alpha, const double *a, const int *lda, const double *b,
-            const int *ldb, const double *beta, double *c, const int *ldc, size_t lta,
-            size_t ltb)
-{
-    static gemm_f *next = NULL;
-    int rows, cols, incx, one = 1;
-    if (one_column(ta, tb, m, n, k, ldb, &rows, &cols, &incx)) {
-        dgemv_(ta, &rows, &cols, alpha, a, lda, b, &incx, beta, c, &one, 1);
-        return;
+/* xGEMM (x: d, s) of real type T, one column to xGEMV, the rest to the library's */
+#define GEMM_ONE_COLUMN(x, T)                                                                   \
+    void x##gemm_(const char *ta, const char *tb, const int *m, const int *n, const int *k,     \
+                  const T *alpha, const T *a, const int *lda, const T *b, const int *ldb,       \
+                  const T *beta, T *c, const int *ldc, size_t lta, size_t ltb)                  \
+    {                                                                                           \
+        static gemm_f *next = NULL;                                                             \
+        int rows, cols, incx, one = 1;                                                          \
+        if (one_column(ta, tb, m, n, k, ldb, &rows, &cols, &incx)) {                            \
+            x##gemv_(ta, &rows, &cols, alpha, a, lda, b, &incx, beta, c, &one, 1);              \
+            return;                                                                             \
+        }                                                                                       \
+        if (!next)                                                                              \
+            next = (gemm_f *)next_blas(#x "gemm_");                                             \
+        next(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);                   \
     }
-    if (!next)
-        next = (gemm_f *)next_blas("dgemm_");
-    next(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
-}
 
-void sgemm_(const char *ta, const char *tb, const int *m, const int *n, const int *k,
-            const float *alpha, const float *a, const int *lda, const float *b,
-            const int *ldb, const float *beta, float *c, const int *ldc, size_t lta,
-            size_t ltb)
-{
-    static gemm_f *next = NULL;
-    int rows, cols, incx, one = 1;
-    if (one_column(ta, tb, m, n, k, ldb, &rows, &cols, &incx)) {
-        sgemv_(ta, &rows, &cols, alpha, a, lda, b, &incx, beta, c, &one, 1);
-        return;
-    }
-    if (!next)
-        next = (gemm_f *)next_blas("sgemm_");
-    next(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc, lta, ltb);
-}
-
+GEMM_ONE_COLUMN(d, double)
+GEMM_ONE_COLUMN(s, float)
