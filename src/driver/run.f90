@@ -58,6 +58,7 @@ module casca_run
     type(scheme_t) :: nm                        !< the time integration scheme
     type(step_control_t) :: sc                  !< steps by an error estimate (tol > 0)
     real(dp) :: dt_try = 0                      !< with sc: the next step's length
+    logical :: onset = .false.                  !< with sc: a contact begins at this step's end or start
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
     !> the energy a step made (the remainder of the balance fell): the largest, when, and the
     !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
@@ -401,17 +402,28 @@ contains
         h = min(r%deck%run%dt/2**r%level, t_end - st%t)
         return
       end if
-      h = interval/2._dp**max(0, ceiling(log(interval/r%dt_try)/log(2._dp) - 1e-9_dp))
+      h = level(r%dt_try)
       h = min((floor(st%t/h + 1e-9_dp) + 1)*h - st%t, t_end - st%t)
+      r%onset = .false.
       if (.not. allocated(r%contact)) return
       r%contact%time = st%t
       hit = time_to_contact(r%contact, r%model, st%q, st%qd, h)
-      ! (a touch at the step's start, where the last step ended, is no landing: a sliver of a
-      ! step would stop the node in it, a force of m v / sliver)
-      if (hit < h .and. hit > r%sc%dt_min) then
+      if (hit <= r%sc%dt_min) then
+        ! touching at the start (the last step ended on it): no sliver of a landing, which would
+        ! stop the node within it (a force m v / sliver), but the deck's dt from here
+        h = min(h, level(r%deck%run%dt))
+        r%onset = .true.
+      else if (hit < h) then
         h = hit
+        r%onset = .true.
       end if
     end associate
+  contains
+    !> the frame interval over the power of 2 that makes it at most x
+    real(dp) function level(x)
+      real(dp), intent(in) :: x
+      level = interval/2._dp**max(0, ceiling(log(interval/x)/log(2._dp) - 1e-9_dp))
+    end function level
   end function step_length
 
   !> With the error control: is the step just taken within the tolerance (or at the shortest
@@ -423,14 +435,13 @@ contains
     real(dp) :: err, ratio, h
     logical, allocatable :: skip(:)
     h = r%nm%dt
-    ! the contact's nodes (impactor and target element, at either end) are left out: their
-    ! acceleration jumps where a contact starts or ends, whatever the step
+    ! the nodes of the contacts at the step's end (impactor and target element) are left out:
+    ! their acceleration follows the contact force, which jumps where it starts, and their
+    ! velocity is the correction's; a contact that ended within the step counts (when it
+    ! ended is within the step's error)
     allocate (skip(r%model%nnode))
     skip = .false.
-    if (present(contact_before)) then
-      call touching(contact_before)
-      call touching(r%contact)
-    end if
+    if (present(contact_before)) call touching(r%contact)
     err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd, skip)
     ratio = next_step_ratio(r%sc, err)
     ok = err <= 1 .or. h <= r%sc%dt_min
@@ -439,6 +450,8 @@ contains
     else
       r%dt_try = max(h*ratio, r%sc%dt_min)
     end if
+    ! the step after a contact's onset is the deck's dt at most, grown again as the error allows
+    if (r%onset) r%dt_try = min(r%dt_try, r%deck%run%dt)
   contains
     !> mark the nodes of c's active constraints: the impactor's and its target element's
     subroutine touching(c)
