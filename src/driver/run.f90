@@ -321,7 +321,7 @@ contains
           return
         end if
         if (r%sc%tol > 0) then
-          if (.not. step_accepted(r, st_before, contact_before)) then
+          if (.not. step_accepted(r, st_before)) then
             st = st_before
             if (allocated(r%contact)) r%contact = contact_before
             cycle
@@ -428,10 +428,9 @@ contains
 
   !> With the error control: is the step just taken within the tolerance (or at the shortest
   !> step)? Sets the next step's length.
-  logical function step_accepted(r, before, contact_before) result(ok)
+  logical function step_accepted(r, before) result(ok)
     type(run_t), intent(inout) :: r
     type(state_t), intent(in) :: before
-    type(contact_t), intent(in), optional :: contact_before
     real(dp) :: err, ratio, h
     logical, allocatable :: skip(:)
     h = r%nm%dt
@@ -441,7 +440,7 @@ contains
     ! ended is within the step's error)
     allocate (skip(r%model%nnode))
     skip = .false.
-    if (present(contact_before)) call touching(r%contact)
+    if (allocated(r%contact)) call touching(r%contact)
     err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd, skip)
     ratio = next_step_ratio(r%sc, err)
     ok = err <= 1 .or. h <= r%sc%dt_min
