@@ -273,10 +273,10 @@ contains
       interval = deck%output%interval
       if (interval == unset) interval = deck%run%t_end/100
       interval = max(interval, dt)
-      next_frame = (floor(st%t/interval + 1e-9_dp) + 1)*interval
+      next_frame = next_multiple(st%t, interval)
       next_ckpt = huge(1._dp)
       if (deck%output%checkpoint_interval > 0) &
-        next_ckpt = (floor(st%t/deck%output%checkpoint_interval + 1e-9_dp) + 1)*deck%output%checkpoint_interval
+        next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
       if (r%restart_step < 0) then
         call start_acceleration(r)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
@@ -403,7 +403,7 @@ contains
         return
       end if
       h = level(r%dt_try)
-      h = min((floor(st%t/h + 1e-9_dp) + 1)*h - st%t, t_end - st%t)
+      h = min(next_multiple(st%t, h) - st%t, t_end - st%t)
       r%onset = .false.
       if (.not. allocated(r%contact)) return
       r%contact%time = st%t
@@ -425,6 +425,13 @@ contains
       level = interval/2._dp**max(0, ceiling(log(interval/x)/log(2._dp) - 1e-9_dp))
     end function level
   end function step_length
+
+  !> The first multiple of h after t (t within 1e-9 h of a multiple is on it): frames,
+  !> checkpoints and the error control's grid of step lengths
+  pure real(dp) function next_multiple(t, h)
+    real(dp), intent(in) :: t, h
+    next_multiple = (floor(t/h + 1e-9_dp) + 1)*h
+  end function next_multiple
 
   !> With the error control: is the step just taken within the tolerance (or at the shortest
   !> step)? Sets the next step's length.

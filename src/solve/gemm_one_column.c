@@ -5,9 +5,10 @@
  * front's factor panel by the right-hand side with xGEMM. OpenBLAS 0.3.21 (Debian 12) first
  * packs the whole panel into its buffers, which for one column costs as much as the product
  * (perf: 18% of a three-sphere run in those copies). xGEMV reads the panel once: the solution
- * phase takes 0.7 to 0.85 of its time (docs/performance.md). (xTRSM packs too, but forwarding
- * it to xTRSV gained nothing measurable.) An executable's own dgemm_ takes precedence over the shared
- * library's for every caller, MUMPS included (the library's is found with RTLD_NEXT). */
+ * phase takes 0.71 to 0.87 of its time (docs/performance.md). (xTRSM packs too, but forwarding
+ * it to xTRSV gained nothing measurable.) An executable's own dgemm_ takes precedence over
+ * the shared library's for every caller, MUMPS included (the library's is found with
+ * RTLD_NEXT). */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <stddef.h>

@@ -2,8 +2,9 @@
 !> estimated from the change of acceleration over it (casca_time_scheme's error_coefficient,
 !> Zienkiewicz & Xie 1991), as a length per node (the mid-surface point's, and the fibre's
 !> times half the thickness: the faces' motion), against tolerance times the scene's size.
-!> The nodes of active contacts are left out (the caller's skip): their acceleration jumps
-!> where a contact starts or ends, a jump the velocity correction takes, not the step.
+!> The nodes of the contacts active at the step's end are left out (the caller's skip): their
+!> acceleration follows the contact force, which jumps where it starts; a contact that ended
+!> within the step counts.
 !> The local error is O(dt^3), so the next step is dt (safety / err)^(1/3), within a growth
 !> and a shrink limit; a step whose error is above 1 is taken again shorter (casca_run, which
 !> also ends steps at a predicted contact and rounds the length down to the frame interval
