@@ -41,6 +41,10 @@ never          two rings closing at 6 m/s: no 'never meets' warning; ring1 movin
 large dt       the closing rings with dt 5e-5 s (3e-4 m per step): no warning; dt 0.05 s
                (0.3 m per step, beyond the band 1.25 h + half a sub-triangle edge < 0.13 m):
                warned, the per-step travel printed as 6 dt (1e-4).
+tracked        ring2 placed at x = 2.1 with the track point (0, 1, 0) given in its mesh's own
+               coordinates: warned, the printed distance equal to the nearest node's, computed
+               here from the mesh file's nodes moved by the center (1e-4), and the percentage of
+               the body's bounding-box diagonal; the placed point (2.1, 1, 0): no warning.
 bad value      flip_normals = 3: exit 2, the message names the deck, its line and the field.
 element_size   generated ring (R 1, width 0.2), sphere (R 0.5) and plate (1 x 0.35) with
                element_size 0.1: element counts equal those counted from the geometry here
@@ -316,6 +320,28 @@ m = re.search(r"'ring1' -> 'ring2' closes (\S+) m in one step", err)
 ck.record("rings closing at 6 m/s, dt 0.05 s: exit 0, warned", code == 0 and m is not None, str(warnings(err)))
 if m:
     ck.close("dt 0.05 s: the travel in one step = 6 dt [m]", float(m.group(1)), 6 * 0.05, 1e-4)
+
+# a track point given in the mesh's coordinates instead of the placed scene's
+def tracked(point):
+    return rings(10.0, 5.0e-5, 1.0e-3) + f"""&output track = {point}, track_body = 'ring2' /
+"""
+
+
+import meshio  # noqa: E402
+xr = meshio.read(ring).points + [2.1, 0.0, 0.0]
+dist = min(math.dist(x, (0.0, 1.0, 0.0)) for x in xr)
+diag = math.dist(xr.min(axis=0), xr.max(axis=0))
+code, out, err, b = check("track_far", tracked("0.0, 1.0, 0.0"))
+m = re.search(r"&output track 1: the nearest node of 'ring2' is (\S+) m from .*, (\d+)% of the body's size", err)
+ck.record("track point (0, 1, 0) with ring2 at x = 2.1: exit 0, warned", code == 0 and m is not None,
+          str(warnings(err)))
+if m:
+    ck.close("the warned distance = the nearest node's, from the mesh file [m]", float(m.group(1)), dist, 1e-4)
+    ck.record("the warned percentage = 100 distance / bounding-box diagonal (%d)" % round(100 * dist / diag),
+              int(m.group(2)) == round(100 * dist / diag), m.group(2))
+code, out, err, b = check("track_near", tracked("2.1, 1.0, 0.0"))
+ck.record("track point (2.1, 1, 0) on the placed ring2: no warning", code == 0 and warnings(err) == [],
+          str(warnings(err)))
 
 # a bad value of the new key
 code, out, err, b = check("bad_flip", f"""&run dt = 1.0e-5, t_end = 1.0e-3 /

@@ -205,6 +205,7 @@ contains
     type(run_t), intent(inout) :: r
     character(len=*), intent(in) :: path, out_dir
     integer :: k
+    character(len=300), allocatable :: far(:)
     call load_scene(path, r%deck, r%model, r%code)
     if (r%code /= exit_ok) return
     allocate (r%ls)
@@ -222,7 +223,12 @@ contains
       allocate (r%fext(model%ndof))
       call gravity_load(model, r%fext)
       r%fext = r%fext + model%fext
-      call tracked_nodes(deck, model, r%tracked)
+      call tracked_nodes(deck, model, r%tracked, far)
+      if (is_root()) then
+        do k = 1, size(far)
+          write (0, '(a)') 'warning: '//trim(far(k))
+        end do
+      end if
       allocate (r%labels(size(r%tracked)))
       do k = 1, size(r%tracked)
         associate (b => model%body(model%node_body(r%tracked(k))))

@@ -15,7 +15,7 @@ module casca_scene
   use casca_obstacle, only: obstacle_t
   use casca_contact, only: contact_t, contact_init
   use casca_orientation, only: reverse_elements, edge_census_t, edge_census
-  use casca_strings, only: itoa
+  use casca_strings, only: itoa, rtoa
   implicit none
   private
   public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles, &
@@ -313,13 +313,18 @@ contains
   end subroutine initial_state
 
   !> The node nearest to each tracked point (of the named body, if one is given).
-  subroutine tracked_nodes(deck, model, nodes)
+  subroutine tracked_nodes(deck, model, nodes, far)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
     integer, allocatable, intent(out) :: nodes(:)
+    !> a warning per track point farther from its node than 5% of the body's size (a point
+    !> given in the mesh's own coordinates, before the body was placed, lands silently on
+    !> whichever node is nearest)
+    character(len=300), allocatable, intent(out), optional :: far(:)
     integer :: k, n, kb
-    real(dp) :: d, best
+    real(dp) :: d, best, size_b
     allocate (nodes(deck%output%ntrack))
+    if (present(far)) allocate (far(0))
     do k = 1, deck%output%ntrack
       kb = 0
       if (deck%output%track_body(k) /= '') &
@@ -333,6 +338,16 @@ contains
           best = d; nodes(k) = n
         end if
       end do
+      if (.not. present(far)) cycle
+      associate (b => model%body(model%node_body(nodes(k))))
+        size_b = norm2(maxval(model%x0(:, b%node_first:b%node_last), dim=2) - &
+                       minval(model%x0(:, b%node_first:b%node_last), dim=2))
+        if (best > 0.05_dp*size_b) far = [character(len=300) :: far, '&output track '// &
+          itoa(k)//': the nearest node of '''//b%name//''' is '//rtoa(best)//' m from ('// &
+          rtoa(deck%output%track(1, k))//', '//rtoa(deck%output%track(2, k))//', '// &
+          rtoa(deck%output%track(3, k))//'), '//itoa(nint(100*best/size_b))//'% of the '// &
+          'body''s size: track points are in the scene''s coordinates (after center and rotate)']
+      end associate
     end do
   end subroutine tracked_nodes
 

@@ -29,7 +29,7 @@ module casca_starter
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
   use casca_strings, only: itoa, rtoa, count_of
-  use casca_scene, only: scene_contact, initial_state
+  use casca_scene, only: scene_contact, initial_state, tracked_nodes
   use casca_newmark, only: state_t
   use casca_contact, only: contact_t, search_radius
   use casca_pair_gaps, only: pair_gap_t, pair_gaps_at
@@ -145,6 +145,8 @@ contains
     integer, intent(in) :: out, err
     type(body_facts_t) :: f(model%nbody)
     integer :: b
+    integer, allocatable :: tracked(:)
+    character(len=300), allocatable :: far(:)
     do b = 1, model%nbody
       f(b) = body_facts(model, b)
     end do
@@ -160,6 +162,8 @@ contains
     if (deck%run%analysis == 'dynamic') call time_line(deck, model, out)
     call put_warnings(body_warnings(model, f), err)
     call put_warnings(pair_warnings(deck, model), err)
+    call tracked_nodes(deck, model, tracked, far)
+    call put_warnings(far, err)
   end subroutine starter_report
 
   !> The warning lines w, each 'warning: ...', to unit u
