@@ -42,7 +42,7 @@ large dt       the closing rings with dt 5e-5 s (3e-4 m per step): no warning; d
                (0.3 m per step, beyond the band 1.25 h + half a sub-triangle edge < 0.13 m):
                warned, the per-step travel printed as 6 dt (1e-4).
 tracked        ring2 placed at x = 2.1 with the track point (0, 1, 0) given in its mesh's own
-               coordinates: warned, the printed distance equal to the nearest node's, computed
+               coordinates (1.33 m from ring2, beyond 5% of its size and its longest edge): warned, the printed distance equal to the nearest node's, computed
                here from the mesh file's nodes moved by the center (1e-4), and the percentage of
                the body's bounding-box diagonal; the placed point (2.1, 1, 0): no warning.
 bad value      flip_normals = 3: exit 2, the message names the deck, its line and the field.

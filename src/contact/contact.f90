@@ -76,7 +76,7 @@ module casca_contact
     ! Coulomb friction per pair: dynamic and static coefficients; the step's start positions
     ! and length (friction needs them: without them, as in statics, contact is frictionless)
     real(dp), allocatable :: mu_d(:), mu_s(:)
-    real(dp), allocatable :: x_start(:, :)
+    real(dp), allocatable :: x_start(:, :), g_start(:, :)   !< positions and fibres
     real(dp) :: dt = 0
     real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
     real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]

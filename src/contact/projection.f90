@@ -31,14 +31,17 @@ module casca_contact_projection
 
 contains
 
-  !> The mid-surface positions (3, nnode) of q
-  pure function positions(model, q) result(x)
+  !> The mid-surface positions (3, nnode) of q, or its fibres
+  pure function positions(model, q, fibres) result(x)
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
+    logical, intent(in), optional :: fibres   !< .true.: the fibres G instead
     real(dp) :: x(3, model%nnode)
-    integer :: n
+    integer :: n, m
+    m = 0
+    if (present(fibres)) m = merge(3, 0, fibres)
     do n = 1, model%nnode
-      x(:, n) = q(dof(n, 1):dof(n, 3))
+      x(:, n) = q(dof(n, m + 1):dof(n, m + 3))
     end do
   end function positions
 
@@ -172,7 +175,7 @@ contains
     !> displacement of the node over the step
     subroutine friction_geometry()
       real(dp) :: u(3), t1(3)
-      integer :: jj
+      integer :: jj, nd
       if (con%grip == 0) return
       t1 = con%t(:, 1) - dot_product(con%t(:, 1), con%n)*con%n
       if (norm2(t1) < 0.5_dp) then   ! (a new constraint: any direction across n)
@@ -181,10 +184,13 @@ contains
       end if
       con%t(:, 1) = t1/norm2(t1)
       con%t(:, 2) = cross(con%n, con%t(:, 1))
-      u = x(:, con%node) - c%x_start(:, con%node)
+      ! between faces the slip is the faces' (P = Y + wg(1) G, T = sum_j N_j (Y_j - wg(2) G_j)):
+      ! a hoop rolls without slipping on its outer face, not on its mid-surface
+      u = x(:, con%node) - c%x_start(:, con%node) + con%wg(1)*fibre_change(con%node)
       if (con%elem > 0) then
         do jj = 1, 10
-          u = u - con%shp(jj)*(x(:, model%conn(jj, con%elem)) - c%x_start(:, model%conn(jj, con%elem)))
+          nd = model%conn(jj, con%elem)
+          u = u - con%shp(jj)*(x(:, nd) - c%x_start(:, nd) - con%wg(2)*fibre_change(nd))
         end do
       else
         u = u - c%dt*c%obstacle(-bt)%velocity
@@ -192,6 +198,13 @@ contains
       con%ut = u - dot_product(u, con%n)*con%n
       con%gt = [dot_product(u, con%t(:, 1)), dot_product(u, con%t(:, 2))]
     end subroutine friction_geometry
+
+    !> the change of node k's fibre over the step
+    function fibre_change(k) result(dg)
+      integer, intent(in) :: k
+      real(dp) :: dg(3)
+      dg = q(dof(k, 4):dof(k, 6)) - c%g_start(:, k)
+    end function fibre_change
   end subroutine constraint_geometry
 
   !> Distance f along u of face s of a shell, (h/2) s G.u (along the current fibre, at the
@@ -241,11 +254,12 @@ contains
 
   !> Row of C of one constraint as a scalar row over the nodes' vector parameters times a
   !> direction: C_row = sum_j w(j) e(node(j), par(j)) (x) dir, par 0 the mid-surface point Y,
-  !> 1 the fibre G (the Y entries first). kind 0: the normal row, the mid-surface points
-  !> along n and, between faces, the fibres that carry the offset; kind 1, 2: the stick rows
-  !> along t1, t2; kind 3: along the slip direction s (the sliding force's, mu_d |lambda| on
-  !> it). force: the normal row as the force acts, at shpf. (The correction's mass solves
-  !> need the scalar row only: one column per row, not one per component.)
+  !> 1 the fibre G (the Y entries first). kind 0: the normal row along n; kind 1, 2: the stick
+  !> rows along t1, t2; kind 3: along the slip direction s (the sliding force's, mu_d |lambda|
+  !> on it). Each acts on the mid-surface points and, between faces, on the fibres that carry
+  !> the offset: the faces touch, and stick or slide, where they are. force: the normal row
+  !> as the force acts, at shpf. (The correction's mass solves need the scalar row only: one
+  !> column per row, not one per component.)
   pure subroutine row_factors(a, model, kind, force, node, par, w, nw, dir)
     type(constraint_t), intent(in) :: a
     type(model_t), intent(in) :: model
@@ -262,7 +276,7 @@ contains
     call constraint_entries(a, model, node(1:11), w(1:11), nn, force .and. kind == 0)
     par(1:nn) = 0
     nw = nn
-    if (kind /= 0 .or. all(a%wg == 0)) return
+    if (all(a%wg == 0)) return   ! (every kind: the stick and slip rows are the faces' too)
     do j = 1, nn
       if (merge(a%wg(1), a%wg(2), j == 1) == 0) cycle   ! (so the pattern follows wg only)
       nw = nw + 1; node(nw) = node(j); par(nw) = 1

@@ -217,6 +217,7 @@ contains
       ! carry a grip)
       if (any(ints(9:2 + per*nact:per) /= 0)) then
         contact%x_start = positions(model, st%q); contact%dt = 0
+        contact%g_start = positions(model, st%q, fibres=.true.)
       end if
     end if
     do k = 1, nact

@@ -317,12 +317,12 @@ contains
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
     integer, allocatable, intent(out) :: nodes(:)
-    !> a warning per track point farther from its node than 5% of the body's size (a point
-    !> given in the mesh's own coordinates, before the body was placed, lands silently on
-    !> whichever node is nearest)
+    !> a warning per track point farther from its node than both 5% of the body's size and
+    !> its longest element edge (a point given in the mesh's own coordinates, before the body
+    !> was placed, lands silently on whichever node is nearest)
     character(len=300), allocatable, intent(out), optional :: far(:)
-    integer :: k, n, kb
-    real(dp) :: d, best, size_b
+    integer :: k, n, kb, e
+    real(dp) :: d, best, size_b, edge
     allocate (nodes(deck%output%ntrack))
     if (present(far)) allocate (far(0))
     do k = 1, deck%output%ntrack
@@ -342,7 +342,13 @@ contains
       associate (b => model%body(model%node_body(nodes(k))))
         size_b = norm2(maxval(model%x0(:, b%node_first:b%node_last), dim=2) - &
                        minval(model%x0(:, b%node_first:b%node_last), dim=2))
-        if (best > 0.05_dp*size_b) far = [character(len=300) :: far, '&output track '// &
+        edge = 0
+        do e = b%elem_first, b%elem_last
+          associate (v => model%x0(:, model%conn(1:3, e)))
+            edge = max(edge, norm2(v(:, 1) - v(:, 2)), norm2(v(:, 2) - v(:, 3)), norm2(v(:, 3) - v(:, 1)))
+          end associate
+        end do
+        if (best > max(0.05_dp*size_b, edge)) far = [character(len=300) :: far, '&output track '// &
           itoa(k)//': the nearest node of '''//b%name//''' is '//rtoa(best)//' m from ('// &
           rtoa(deck%output%track(1, k))//', '//rtoa(deck%output%track(2, k))//', '// &
           rtoa(deck%output%track(3, k))//'), '//itoa(nint(100*best/size_b))//'% of the '// &

@@ -59,7 +59,8 @@ contains
       call contact_force_points(contact, model, nm%alpha_f, st%q)   ! (as the last step left them: restarts too)
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
-      contact%x_start = positions(model, st%q); contact%dt = dt   ! (friction's slip)
+      contact%x_start = positions(model, st%q); contact%dt = dt
+      contact%g_start = positions(model, st%q, fibres=.true.)   ! (friction's slip)
     end if
     released = [constraint_t ::]
     call attempt()
