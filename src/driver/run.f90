@@ -261,6 +261,18 @@ contains
     real(dp), allocatable :: q_before(:), qd_before(:)
     type(state_t) :: st_before
     type(contact_t), allocatable :: contact_before
+    type(balance_t) :: bal_before
+    real(dp) :: rest_before, made
+    !> a step that makes more energy than this share of what the bodies hold is taken again
+    !> with half the step (as one where Newton fails): no scheme casca offers makes energy,
+    !> so it is the contact's doing or a mode the step cannot follow; a tenth of this share
+    !> is still warned of at the end (warn_energy)
+    real(dp), parameter :: made_limit = 1e-2_dp
+    !> guarded: the balance is exact step by step (not so for the work of moving obstacles,
+    !> counted as their velocity times the step's impulse, nor for pressures on open
+    !> surfaces); energy_cut: this step was cut for its energy once already (a half step that
+    !> makes energy too is kept: a shorter one made more on a plane pushing a ring)
+    logical :: guarded, energy_cut
     integer :: k
     associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm, rep => r%rep)
       if (deck%run%rho_inf /= unset) then
@@ -276,6 +288,8 @@ contains
         r%sc%dt_min = dt/2**deck%run%max_step_cuts
         if (r%dt_try == 0) r%dt_try = dt
       end if
+      guarded = .not. (moving_obstacles(deck, allocated(r%contact)) .or. any(model%pressure /= 0))
+      energy_cut = .false.
       interval = deck%output%interval
       if (interval == unset) interval = deck%run%t_end/100
       interval = max(interval, dt)
@@ -292,6 +306,8 @@ contains
         if (failed(r, 'history')) return
         call frame(r)
         if (failed(r, 'frame')) return
+      else   ! (the energy before the first step, for the first step's check)
+        call account(model, r%asm, st, r%fext, r%q0, r%bal)
       end if
       if (is_root() .and. .not. r%quiet) print '(a)', 'casca: '//count_of(model%nbody, 'body', 'bodies')// &
         ', '//count_of(model%nelem, 'element', 'elements')//', '// &
@@ -309,17 +325,14 @@ contains
           call give_up(r, r%err%message); return
         end if
         q_before = st%q; qd_before = st%qd
-        if (r%sc%tol > 0) then   ! (to take the step again)
-          st_before = st
-          if (allocated(r%contact)) contact_before = r%contact
-        end if
+        st_before = st   ! (to take the step again)
+        bal_before = r%bal
+        if (allocated(r%contact)) contact_before = r%contact
+        rest_before = balance_remainder(r%bal0, r%bal, balance_terms(deck, r%contact))
         call newmark_step(model, r%asm, r%ls, nm, r%fext, r%opts, st, rep, r%err, r%contact)
         if (allocated(r%err)) then
           if (r%level < deck%run%max_step_cuts) then
-            r%level = r%level + 1   ! the state is unchanged: retry with half the step
-            r%dt_try = nm%dt/2
-            if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
-              merge(r%dt_try, dt/2**r%level, r%sc%tol > 0), ': ', r%err%message
+            call cut_step(r%err%message)   ! (the state is unchanged)
             deallocate (r%err)
             cycle
           end if
@@ -328,22 +341,31 @@ contains
         end if
         if (r%sc%tol > 0) then
           if (.not. step_accepted(r, st_before)) then
-            st = st_before
-            if (allocated(r%contact)) r%contact = contact_before
+            call undo_step()
             cycle
           end if
         end if
-        r%total_newton = r%total_newton + rep%iters
         if (any(r%idle)) call advance_idle(model, r%idle, nm%dt, q_before, qd_before, st%q, st%qd, st%qdd)
+        call timer_start(t_account)
+        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        call timer_stop(t_account)
+        made = rest_before - balance_remainder(r%bal0, r%bal, balance_terms(deck, r%contact))
+        if (guarded .and. .not. energy_cut .and. made > made_limit*energy_scale() .and. &
+            r%level < deck%run%max_step_cuts .and. .not. (r%held_at_start .and. st%step == 1)) then
+          call undo_step()
+          call cut_step('the step made '//ftoa(100*made/energy_scale())//'% of the energy the '// &
+                        'bodies hold (a node deep into a target, or a mode the step cannot follow)')
+          energy_cut = .true.
+          cycle
+        end if
+        energy_cut = .false.
+        r%total_newton = r%total_newton + rep%iters
         if (r%sc%tol > 0) then
           r%level = 0
         else if (r%level > 0 .and. rep%iters <= 3) then
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
-        call timer_start(t_account)
-        call account(model, r%asm, st, r%fext, r%q0, r%bal)
         call watch_energy(r)
-        call timer_stop(t_account)
         call timer_start(t_output)
         call history_row(r, rep%iters)
         call timer_stop(t_output)
@@ -366,6 +388,27 @@ contains
     call checkpoint(r)
     if (r%code /= exit_ok) return
     call finish(r)
+  contains
+    !> retry from the step's start with half the step
+    subroutine cut_step(why)
+      character(len=*), intent(in) :: why
+      r%level = r%level + 1
+      r%dt_try = r%nm%dt/2
+      if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
+        merge(r%dt_try, dt/2**r%level, r%sc%tol > 0), ': ', why
+    end subroutine cut_step
+
+    subroutine undo_step()
+      r%st = st_before; r%bal = bal_before
+      if (allocated(r%contact)) r%contact = contact_before
+    end subroutine undo_step
+
+    !> what the bodies hold (kinetic and strain energy) or the loads did, before or after
+    !> the step: within a step, so that a restart judges its steps as the run it continues
+    real(dp) function energy_scale()
+      energy_scale = max(bal_before%kinetic + bal_before%strain, r%bal%kinetic + r%bal%strain, &
+                         abs(bal_before%work), abs(r%bal%work))
+    end function energy_scale
   end subroutine dynamic_run
 
   !> Statics: load steps of the dead loads; one history row and frame per load step

@@ -67,6 +67,9 @@ module casca_newton
     real(dp) :: g0 = 0, r0 = 0        !< dq . R and |R| where it was taken
     real(dp) :: alpha = 1, g = 0      !< the fraction taken, and dq . R there
     logical :: stale = .false.        !< taken with kept factors
+    !> taken mostly to close constraints' gaps (a contact just added, a stick's slip): the
+    !> force residual must rise then (the contact force appears), so it does not judge it
+    logical :: closing = .false.
     integer :: set = -1               !< active-set version it was taken with (-1: judged)
     integer :: cuts = 0
   end type increment_t
@@ -233,7 +236,7 @@ contains
     logical function undo_or_shorten()
       real(dp) :: s, alpha
       undo_or_shorten = .false.
-      if (inc%set /= version .or. inc%g0 >= 0) return
+      if (inc%set /= version .or. inc%g0 >= 0 .or. inc%closing) return
       inc%g = dot_product(inc%dq, res)
       if (inc%stale .and. .not. (rnorm <= inc%r0)) then   ! (also NaN)
         call undo()
@@ -307,6 +310,8 @@ contains
       end if
       inc%g0 = dot_product(inc%dq, res); inc%r0 = rnorm
       inc%alpha = 1; inc%cuts = 0; inc%stale = .not. fresh; inc%set = version
+      inc%closing = .false.   ! (the gaps a tenth of the step or more)
+      if (nc > 0) inc%closing = maxval(abs(rows%gap)) > max(contact%tol, 0.1_dp*maxval(abs(inc%dq)))
       call move_to(1._dp)
       rep%nincr = rep%nincr + 1
       rep%incr(rep%nincr) = maxval(abs(inc%dq))/model%length
