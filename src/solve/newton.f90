@@ -8,7 +8,10 @@
 !> makes through the inertia), and (iii) every active constraint's gap is within the contact
 !> tolerance. The active set settles when no multiplier is tensile and no free node
 !> penetrates; one that keeps changing is an error (the caller cuts the step), never
-!> accepted as it is.
+!> accepted as it is. max_iter counts the iterations of one active set: a change starts the
+!> count again (a hoop's contact nodes going from stick to slip one batch per convergence
+!> took 20 iterations in all, and the step was cut although each set converged), and the
+!> changes are counted apart, at most max_set_changes.
 !>
 !> With reuse, a factorisation is kept across iterations and steps while each iteration
 !> shrinks the increment fast enough (modified Newton: only the force is assembled then). A
@@ -94,7 +97,7 @@ contains
     type(constraint_t), allocatable :: act_entry(:)
     type(rows_t) :: rows
     type(increment_t) :: inc
-    integer :: it, nc, version
+    integer :: it, it_set, nc, version
     real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
     logical :: fresh, refresh_next
 
@@ -110,7 +113,10 @@ contains
     end if
     ffloor = inertial_floor()
     refresh_next = .false.
-    do it = 1, min(opts%max_iter, max_hist)
+    it_set = 0
+    do it = 1, max_hist
+      it_set = it_set + 1
+      if (it_set > opts%max_iter) exit
       rep%iters = it
       call constraints(reproject=it == 1)
       call timer_start(t_analysis)
@@ -140,6 +146,7 @@ contains
       if (residual_estimate() > max(opts%force_tol*fref, ffloor)) cycle
       if (set_changed()) then
         if (allocated(err)) exit
+        it_set = 0   ! (each set has its own max_iter; at most max_set_changes sets)
         cycle
       end if
       if (gap_open()) cycle
