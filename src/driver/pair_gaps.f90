@@ -115,12 +115,7 @@ contains
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:), qd(:)
     type(pair_gap_t) :: pg(c%npairs)
-    real(dp) :: g(3, model%nnode)
-    integer :: n
-    do n = 1, model%nnode
-      g(:, n) = q(dof(n, 4):dof(n, 6))
-    end do
-    pg = pair_gaps(c, model, positions(model, q), g, positions(model, qd))
+    pg = pair_gaps(c, model, positions(model, q), positions(model, q, fibres=.true.), positions(model, qd))
   end function pair_gaps_at
 
   !> body b's face along u, as a new constraint chooses it (projection.f90); none between

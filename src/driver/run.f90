@@ -6,6 +6,7 @@ module casca_run
   use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
+  use casca_starter, only: put_warnings
   use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
@@ -224,11 +225,7 @@ contains
       call gravity_load(model, r%fext)
       r%fext = r%fext + model%fext
       call tracked_nodes(deck, model, r%tracked, far)
-      if (is_root()) then
-        do k = 1, size(far)
-          write (0, '(a)') 'warning: '//trim(far(k))
-        end do
-      end if
+      if (is_root()) call put_warnings(far, 0)
       allocate (r%labels(size(r%tracked)))
       do k = 1, size(r%tracked)
         associate (b => model%body(model%node_body(r%tracked(k))))
@@ -262,7 +259,7 @@ contains
     type(state_t) :: st_before
     type(contact_t), allocatable :: contact_before
     type(balance_t) :: bal_before
-    real(dp) :: rest_before, made
+    real(dp) :: rest, made
     !> a step that makes more energy than this share of what the bodies hold is taken again
     !> with half the step (as one where Newton fails): no scheme casca offers makes energy,
     !> so it is the contact's doing or a mode the step cannot follow; a tenth of this share
@@ -301,13 +298,14 @@ contains
         call start_acceleration(r)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
         r%bal0 = r%bal
-        call watch_energy(r)
+        call watch_energy(r, rest_now(r))
         call history_row(r, 0)
         if (failed(r, 'history')) return
         call frame(r)
         if (failed(r, 'frame')) return
       else   ! (the energy before the first step, for the first step's check)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        r%rest_last = rest_now(r)
       end if
       if (is_root() .and. .not. r%quiet) print '(a)', 'casca: '//count_of(model%nbody, 'body', 'bodies')// &
         ', '//count_of(model%nelem, 'element', 'elements')//', '// &
@@ -328,7 +326,6 @@ contains
         st_before = st   ! (to take the step again)
         bal_before = r%bal
         if (allocated(r%contact)) contact_before = r%contact
-        rest_before = balance_remainder(r%bal0, r%bal, balance_terms(deck, r%contact))
         call newmark_step(model, r%asm, r%ls, nm, r%fext, r%opts, st, rep, r%err, r%contact)
         if (allocated(r%err)) then
           if (r%level < deck%run%max_step_cuts) then
@@ -349,9 +346,10 @@ contains
         call timer_start(t_account)
         call account(model, r%asm, st, r%fext, r%q0, r%bal)
         call timer_stop(t_account)
-        made = rest_before - balance_remainder(r%bal0, r%bal, balance_terms(deck, r%contact))
-        if (guarded .and. .not. energy_cut .and. made > made_limit*energy_scale() .and. &
-            r%level < deck%run%max_step_cuts .and. .not. (r%held_at_start .and. st%step == 1)) then
+        rest = rest_now(r)
+        made = r%rest_last - rest
+        if (guarded .and. .not. energy_cut .and. step_judged(r) .and. &
+            made > made_limit*energy_scale() .and. r%level < deck%run%max_step_cuts) then
           call undo_step()
           call cut_step('the step made '//ftoa(100*made/energy_scale())//'% of the energy the '// &
                         'bodies hold (a node deep into a target, or a mode the step cannot follow)')
@@ -365,7 +363,7 @@ contains
         else if (r%level > 0 .and. rep%iters <= 3) then
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
-        call watch_energy(r)
+        call watch_energy(r, rest)
         call timer_start(t_output)
         call history_row(r, rep%iters)
         call timer_stop(t_output)
@@ -782,11 +780,10 @@ contains
   !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
   !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
   !> and it may only grow with a dissipative scheme (stay, with a conservative one)
-  subroutine watch_energy(r)
+  subroutine watch_energy(r, rest)
     type(run_t), intent(inout) :: r
-    real(dp) :: rest
-    rest = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact))
-    if (r%st%step > merge(1, 0, r%held_at_start) .and. r%rest_last - rest > r%made_max) then
+    real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
+    if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t
       r%made_contacts = 0
       if (allocated(r%contact)) r%made_contacts = r%contact%nact
@@ -794,6 +791,20 @@ contains
     r%rest_last = rest
     r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
   end subroutine watch_energy
+
+  !> energy_balance's remainder at the run's state: E0 less what the bodies hold and the
+  !> terms taken out (what the integrator and the contact removed so far)
+  real(dp) function rest_now(r)
+    type(run_t), intent(in) :: r
+    rest_now = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact))
+  end function rest_now
+
+  !> Whether the step just taken is judged for the energy it made: not the first of a start
+  !> held by its contact (held_at_start)
+  logical function step_judged(r)
+    type(run_t), intent(in) :: r
+    step_judged = r%st%step > merge(1, 0, r%held_at_start)
+  end function step_judged
 
   !> A run from t = 0 whose step made more than 1e-3 of E0 says so: no scheme casca offers
   !> makes energy, so it is the contact's doing

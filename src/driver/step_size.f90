@@ -3,9 +3,9 @@
 !> stepped over.
 module casca_step_size
   use casca_kinds, only: dp
-  use casca_model, only: model_t, dof
+  use casca_model, only: model_t
   use casca_contact, only: contact_t
-  use casca_pair_gaps, only: pair_gap_t, pair_gaps
+  use casca_pair_gaps, only: pair_gap_t, pair_gaps_at
   use casca_free_flight, only: clear_near_contact
   implicit none
   private
@@ -30,21 +30,9 @@ contains
     far = .true.
     call clear_near_contact(model, q, qd, dt, c, far)
     if (all(far)) return
-    pg = pair_gaps(c, model, nodal(1), nodal(4), reshape(qd(idx(1)), [3, model%nnode]))
+    pg = pair_gaps_at(c, model, q, qd)
     do k = 1, size(pg)
       if (pg(k)%time >= 0) t = min(t, pg(k)%time)
     end do
-  contains
-    !> the 3 components from the first at every node, as (3, nnode)
-    function nodal(first) result(x)
-      integer, intent(in) :: first
-      real(dp) :: x(3, model%nnode)
-      x = reshape(q(idx(first)), [3, model%nnode])
-    end function nodal
-    function idx(first) result(i)
-      integer, intent(in) :: first
-      integer :: i(3*model%nnode), n, m
-      i = [((dof(n, m), m=first, first + 2), n=1, model%nnode)]
-    end function idx
   end function time_to_contact
 end module casca_step_size

@@ -36,7 +36,7 @@ module casca_starter
   use casca_sanity, only: bytes_per_element
   implicit none
   private
-  public :: body_facts_t, body_facts, starter_report, thickness_frequency
+  public :: body_facts_t, body_facts, starter_report, thickness_frequency, put_warnings
 
   !> Below this element quality a warning names the element: the area scale of its map then
   !> varies by more than a factor 2 over it
