@@ -111,7 +111,8 @@ contains
       call contact_solve_start(contact)
       act_entry = contact%act(1:contact%nact)
     end if
-    ffloor = inertial_floor()
+    ffloor = 0
+    if (present(cm)) ffloor = inertial_floor(model, cm, opts%tol)
     refresh_next = .false.
     it_set = 0
     do it = 1, max_hist
@@ -155,7 +156,7 @@ contains
       rep%neg_pivots = negative_pivots(ls, asm, nc)
       return
     end do
-    if (.not. allocated(err)) call fatal_error(err, failure_message())
+    if (.not. allocated(err)) call fatal_error(err, failure_message(rep, rnorm, fref))
     q = q_entry
     if (present(contact)) then
       contact%nact = size(act_entry)
@@ -198,18 +199,6 @@ contains
       fref = max(maxval(abs(fext)), fpress, maxval(abs(r + fext), mask=.not. model%fixed), &
                  maxval(abs(res - r), mask=.not. model%fixed))
     end subroutine full_residual
-
-    !> Force of the inertia of the heaviest element moved by tol of the scene size in one
-    !> step: below it the residual is round-off of the inertial terms (free flight)
-    real(dp) function inertial_floor()
-      integer :: e
-      inertial_floor = 0
-      if (.not. present(cm)) return
-      do e = 1, model%nelem
-        inertial_floor = max(inertial_floor, sum(model%emass(1:10, 1:10, e)))
-      end do
-      inertial_floor = cm*inertial_floor*opts%tol*model%length
-    end function inertial_floor
 
     !> the residual at the new iterate: the last one, shrunk as the increments contract
     real(dp) function residual_estimate()
@@ -284,31 +273,12 @@ contains
 
     !> solve the saddle-point system for (dq, dlambda) and step
     subroutine take_increment()
-      real(dp), allocatable :: b(:), x(:), d(:)
-      integer :: i
+      real(dp), allocatable :: d(:)
       logical :: renew
-      allocate (b(asm%neq + nc), x(asm%neq + nc), d(model%ndof + nc))
-      do i = 1, model%ndof
-        if (asm%eq(i) > 0) b(asm%eq(i)) = -res(i)
-      end do
-      b(asm%neq + 1:) = -rows%gap
       renew = .false.
       if (rep%nincr >= 2) renew = contraction() > 0.25_dp
-      call timer_start(t_solve)
-      call kkt_solve(ls, asm, rows, b, renew, x, err)
-      if (allocated(err)) then
-        call timer_stop(t_solve); return
-      end if
-      ! the whole increment on every rank: each block's host gives its part (x is zero in
-      ! the blocks a rank does not host), rank 0 the multipliers' (every rank has them with
-      ! 'schur'; rank 0 is the only host with 'saddle')
-      d = 0
-      do i = 1, model%ndof
-        if (asm%eq(i) > 0) d(i) = x(asm%eq(i))
-      end do
-      if (is_root()) d(model%ndof + 1:) = x(asm%neq + 1:)
-      call sum_all(d)
-      call timer_stop(t_solve)
+      call solve_increment(model, asm, ls, rows, res, renew, d, err)
+      if (allocated(err)) return
       inc%q = q; inc%dq = d(1:model%ndof); inc%dlambda = d(model%ndof + 1:)
       if (nc > 0) then
         inc%lambda = contact_multipliers(contact)
@@ -366,13 +336,63 @@ contains
       gap_open = contact_max_gap(contact) > contact%tol
     end function gap_open
 
-    function failure_message() result(msg)
-      character(len=:), allocatable :: msg
-      character(len=160) :: buf
-      write (buf, '(a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge in ', rep%iters, &
-        ' iterations (last increment ', rep%incr(max(rep%nincr, 1)), &
-        ' of the scene size, residual ', rnorm/max(fref, tiny(1._dp)), ' of the scene force)'
-      msg = trim(buf)
-    end function failure_message
   end subroutine newton_solve
+  !> Force of the inertia of the heaviest element moved by tol of the scene size in one step
+  !> (cm: the inertia's factor): below it the residual is round-off of the inertial terms
+  real(dp) function inertial_floor(model, cm, tol)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: cm, tol
+    integer :: e
+    inertial_floor = 0
+    do e = 1, model%nelem
+      inertial_floor = max(inertial_floor, sum(model%emass(1:10, 1:10, e)))
+    end do
+    inertial_floor = cm*inertial_floor*tol*model%length
+  end function inertial_floor
+
+  !> Solve the saddle-point system for the increment d = (dq, dlambda) of the residual res
+  !> and the rows' gaps, gathered whole on every rank
+  subroutine solve_increment(model, asm, ls, rows, res, renew, d, err)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(in) :: asm
+    type(linear_system_t), intent(inout) :: ls
+    type(rows_t), intent(in) :: rows
+    real(dp), intent(in) :: res(:)
+    logical, intent(in) :: renew
+    real(dp), allocatable, intent(out) :: d(:)
+    type(error_t), allocatable, intent(out) :: err
+    real(dp), allocatable :: b(:), x(:)
+    integer :: i, nc
+    nc = size(rows%gap)
+    allocate (b(asm%neq + nc), x(asm%neq + nc), d(model%ndof + nc))
+    do i = 1, model%ndof
+      if (asm%eq(i) > 0) b(asm%eq(i)) = -res(i)
+    end do
+    b(asm%neq + 1:) = -rows%gap
+    call timer_start(t_solve)
+    call kkt_solve(ls, asm, rows, b, renew, x, err)
+    if (allocated(err)) then
+      call timer_stop(t_solve); return
+    end if
+    ! each block's host gives its part (x is zero in the blocks a rank does not host), rank 0
+    ! the multipliers' (every rank has them with 'schur'; rank 0 is the only host with 'saddle')
+    d = 0
+    do i = 1, model%ndof
+      if (asm%eq(i) > 0) d(i) = x(asm%eq(i))
+    end do
+    if (is_root()) d(model%ndof + 1:) = x(asm%neq + 1:)
+    call sum_all(d)
+    call timer_stop(t_solve)
+  end subroutine solve_increment
+
+  function failure_message(rep, rnorm, fref) result(msg)
+    type(newton_report_t), intent(in) :: rep
+    real(dp), intent(in) :: rnorm, fref
+    character(len=:), allocatable :: msg
+    character(len=160) :: buf
+    write (buf, '(a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge in ', rep%iters, &
+      ' iterations (last increment ', rep%incr(max(rep%nincr, 1)), &
+      ' of the scene size, residual ', rnorm/max(fref, tiny(1._dp)), ' of the scene force)'
+    msg = trim(buf)
+  end function failure_message
 end module casca_newton
