@@ -43,6 +43,8 @@ module casca_contact
     real(dp) :: gt(2) = 0       !< stick rows' gaps: relative tangential displacement in the step
     real(dp) :: s(3) = 0        !< slip direction of the node relative to the target, held
     real(dp) :: ut(3) = 0       !< relative tangential displacement in the step
+    !> the friction force on the node at the step's start (the last step's end), for its work
+    real(dp) :: fa(3) = 0
     integer :: flips = 0        !< stick/slip changes in this step
   end type constraint_t
 

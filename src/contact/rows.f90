@@ -11,7 +11,7 @@ module casca_contact_rows
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
-  public :: constraint_nkinds, slip_force, add_step_impulse, pair_forces, contact_force_points
+  public :: constraint_nkinds, slip_force, friction_force, add_step_impulse, pair_forces, contact_force_points
 
 contains
 
@@ -234,10 +234,18 @@ contains
     type(contact_t), intent(in) :: c
     type(constraint_t), intent(in) :: a
     real(dp) :: f(3)
-    f = -a%lambda*a%n
-    if (a%grip == stick) f = f - a%lt(1)*a%t(:, 1) - a%lt(2)*a%t(:, 2)
-    if (a%grip == slip) f = f - slip_force(c, a)*a%s
+    f = -a%lambda*a%n + friction_force(c, a)
   end function node_force
+
+  !> The friction force on the constraint's node (0 without friction)
+  pure function friction_force(c, a) result(f)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    real(dp) :: f(3)
+    f = 0
+    if (a%grip == stick) f = -a%lt(1)*a%t(:, 1) - a%lt(2)*a%t(:, 2)
+    if (a%grip == slip) f = -slip_force(c, a)*a%s
+  end function friction_force
 
   !> Nodal contact force (3, nnode) on the bodies (both sides of a pair): normal and friction
   pure subroutine contact_nodal_fields(c, model, force)

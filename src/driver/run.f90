@@ -446,7 +446,11 @@ contains
     real(dp) :: hit
     associate (st => r%st, t_end => r%deck%run%t_end)
       if (r%sc%tol <= 0) then
-        h = min(r%deck%run%dt/2**r%level, t_end - st%t)
+        h = r%deck%run%dt/2**r%level
+        ! off its own grid (grown back after a cut): to the grid, so that the steps land on the
+        ! deck's dt again and the frames on their times (on it: h itself, as a restart does)
+        if (next_multiple(st%t, h) - st%t < (1 - 1e-6_dp)*h) h = next_multiple(st%t, h) - st%t
+        h = min(h, t_end - st%t)
         return
       end if
       h = level(r%dt_try)
@@ -473,11 +477,12 @@ contains
     end function level
   end function step_length
 
-  !> The first multiple of h after t (t within 1e-9 h of a multiple is on it): frames,
-  !> checkpoints and the error control's grid of step lengths
+  !> The first multiple of h after t (t within 1e-6 h of a multiple is on it, as the frames
+  !> are: t is a sum of steps, and its rounding grows with their number): frames,
+  !> checkpoints and the grid of step lengths
   pure real(dp) function next_multiple(t, h)
     real(dp), intent(in) :: t, h
-    next_multiple = (floor(t/h + 1e-9_dp) + 1)*h
+    next_multiple = (floor(t/h + 1e-6_dp) + 1)*h
   end function next_multiple
 
   !> With the error control: is the step just taken within the tolerance (or at the shortest

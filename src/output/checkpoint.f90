@@ -84,7 +84,8 @@ contains
       ! trapezoidal rule: kinetic energy 0.03% off in that step, 14% later). With friction,
       ! the stick/slip state, the stick multipliers and their corrections, the slip
       ! direction; then the work summed so far (friction per pair, moving obstacles); last
-      ! per pair the impulse so far and the start force of the next step (rows.f90).
+      ! per pair the impulse so far and the start force of the next step (rows.f90); last
+      ! friction's start force per constraint (friction.f90).
       call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, &
                             [level, nact, (contact%act(k)%node, contact%act(k)%pair, contact%act(k)%elem, &
                                            contact%act(k)%side, contact%act(k)%face, contact%act(k)%grip, &
@@ -92,7 +93,7 @@ contains
                             [contact%act(1:nact)%lambda, contact%act(1:nact)%mu, &
                              (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
                               k=1, nact), contact%friction_work, contact%obstacle_work, &
-                             contact%impulse, contact%carry], err, &
+                             contact%impulse, contact%carry, (contact%act(k)%fa, k=1, nact)], err, &
                             model_fingerprint(model), dt_next)
     else
       call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, [level, 0], &
@@ -151,8 +152,9 @@ contains
       end if
     end if
     ! 7 integers (node, pair, elem, side, faces, grip) and 2 + 9 reals (lambda, mu; xi, lt,
-    ! mut, s) per constraint, then the works (npairs + 1) and the impulses (6 npairs, absent
-    ! from earlier checkpoints: taken as 0); a checkpoint of casca before these were kept has
+    ! mut, s) per constraint, then the works (npairs + 1), the impulses (6 npairs) and
+    ! friction's start forces (3 nact) (the last two absent from earlier checkpoints: taken as
+    ! 0); a checkpoint of casca before these were kept has
     ! 2 and 1 (node, pair; lambda): it is read, point, side and faces chosen again at the
     ! restart, mu taken as 0, the works as 0
     per = 7
@@ -161,7 +163,8 @@ contains
         per = 2
       else if (size(ints) /= 2 + 7*int(nact, int64) .or. &
                (size(reals) /= 11*int(nact, int64) + contact%npairs + 1 .and. &
-                size(reals) /= 11*int(nact, int64) + 7*contact%npairs + 1)) then
+                size(reals) /= 11*int(nact, int64) + 7*contact%npairs + 1 .and. &
+                size(reals) /= 14*int(nact, int64) + 7*contact%npairs + 1)) then
         bad = 'its contact count '//itoa(nact)//' does not match its contact data'
       end if
       if (bad == '' .and. .not. all(ieee_is_finite(reals))) bad = 'its contact forces are not finite'
@@ -232,6 +235,9 @@ contains
       associate (r => reals(2*nact + 9*k - 8:2*nact + 9*k))
         contact%act(k)%xi = r(1:2); contact%act(k)%lt = r(3:4); contact%act(k)%mut = r(5:6)
         contact%act(k)%s = r(7:9)
+      end associate
+      associate (at => 11*nact + 7*contact%npairs + 1 + 3*(k - 1))
+        if (size(reals) == at - 3*(k - 1) + 3*nact) contact%act(k)%fa = reals(at + 1:at + 3)
       end associate
       ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
       ! that wrote it left them

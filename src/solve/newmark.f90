@@ -93,7 +93,7 @@ contains
     end if
     if (present(contact)) then   ! (before friction turns its slip directions)
       call add_step_impulse(contact, nm, released, nu, f_end)
-      call friction_step_done(contact)
+      call friction_step_done(contact, nm, before)
     end if
     st%q = q; st%qd = qd; st%qdd = qdd
     st%t = st%t + dt
