@@ -4,13 +4,14 @@
 module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t, constraint_t, stick, slip
+  use casca_contact, only: contact_t, constraint_t, stick, slip, normal_compliance, normal_residual
   use casca_contact_projection, only: constraint_entries, constraint_row, max_row, force_point
   use casca_time_scheme, only: scheme_t
   implicit none
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
+  public :: contact_stored_energy
   public :: constraint_nkinds, slip_force, friction_force, add_step_impulse, pair_forces, contact_force_points
 
 contains
@@ -77,8 +78,9 @@ contains
     end do
   end subroutine contact_set_multipliers
 
-  !> Constraint rows for MUMPS: entries (neq + r, eq) of dg_r/dq (irn > jcn), a zero
-  !> diagonal for each multiplier, the gaps, and each row's key (node and kind, element).
+  !> Constraint rows for MUMPS: entries (neq + r, eq) of dg_r/dq (irn > jcn), a diagonal for
+  !> each multiplier (zero, or minus a compliant normal row's compliance), the rows' residuals
+  !> (the gaps, less compliance times lambda), and each row's key (node and kind, element).
   !> fval: the same entries of the columns the multipliers act through: C^T where the force
   !> acts (force_point), and for a sliding constraint's normal row n - mu_d s on its points
   !> (its friction follows |lambda|).
@@ -97,8 +99,8 @@ contains
     do k = 1, c%nact
       do kind = 0, constraint_nkinds(c%act(k)) - 1
         r = r + 1
-        if (kind == 0) then
-          gap(r) = c%act(k)%gap
+        if (kind == 0) then   ! (compliant: g - lambda / k, contact_set_stiffness)
+          gap(r) = normal_residual(c, c%act(k))
         else
           gap(r) = c%act(k)%gt(kind)
         end if
@@ -117,6 +119,7 @@ contains
           if (j <= ns) fval(m) = vf(j) - mu*vs(j)
         end do
         m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
+        if (kind == 0) val(m) = -normal_compliance(c, c%act(k))
       end do
     end do
     irn = irn(1:m); jcn = jcn(1:m); val = val(1:m); fval = fval(1:m)
@@ -162,16 +165,31 @@ contains
     contact_force_total = -sum(c%act(1:c%nact)%lambda)
   end function contact_force_total
 
-  !> Largest |gap| of the active rows (normal, and stick rows' tangential displacement)
+  !> Largest residual of the active rows: |gap| (less compliance times lambda) and the stick
+  !> rows' tangential displacement
   pure real(dp) function contact_max_gap(c)
     type(contact_t), intent(in) :: c
     integer :: k
     contact_max_gap = 0
     do k = 1, c%nact
-      contact_max_gap = max(contact_max_gap, abs(c%act(k)%gap))
+      contact_max_gap = max(contact_max_gap, abs(normal_residual(c, c%act(k))))
       if (c%act(k)%grip == stick) contact_max_gap = max(contact_max_gap, maxval(abs(c%act(k)%gt)))
     end do
   end function contact_max_gap
+
+  !> The energy a compliant contact holds at its gaps, k g^2 / 2 over the penetrating active
+  !> constraints [J] (as the strain energy, at the step's end)
+  pure real(dp) function contact_stored_energy(c)
+    type(contact_t), intent(in) :: c
+    integer :: k
+    contact_stored_energy = 0
+    do k = 1, c%nact
+      associate (a => c%act(k))
+        if (c%compliance(a%node) > 0) contact_stored_energy = contact_stored_energy + &
+                                                              0.5_dp*min(a%gap, 0._dp)**2/c%compliance(a%node)
+      end associate
+    end do
+  end function contact_stored_energy
 
   !> The contact force on each pair's impactor (3, npairs): normal and friction
   pure function pair_forces(c) result(f)

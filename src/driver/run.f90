@@ -24,7 +24,7 @@ module casca_run
   use casca_mesh_indicator, only: indicator_line_len
   use casca_contact, only: contact_t
   use casca_contact_active_set, only: contact_update
-  use casca_contact_rows, only: contact_force_total, contact_nodal_fields
+  use casca_contact_rows, only: contact_force_total, contact_nodal_fields, contact_stored_energy
   use casca_contact_probes, only: contact_penetration, contact_signed_distance
   use casca_pair_report, only: pair_normal_force, pair_active_count, pair_labels
   use casca_contact_friction, only: pair_tangential_force
@@ -493,13 +493,16 @@ contains
     real(dp) :: err, ratio, h
     logical, allocatable :: skip(:)
     h = r%nm%dt
-    ! the nodes of the contacts at the step's end (impactor and target element) are left out:
-    ! their acceleration follows the contact force, which jumps where it starts, and their
-    ! velocity is the correction's; a contact that ended within the step counts (when it
-    ! ended is within the step's error)
+    ! the nodes of the hard contacts at the step's end (impactor and target element) are left
+    ! out: their acceleration follows the contact force, which jumps where it starts, and
+    ! their velocity is the correction's; a contact that ended within the step counts (when
+    ! it ended is within the step's error). A compliant contact's force follows its gap: its
+    ! nodes are judged as any other
     allocate (skip(r%model%nnode))
     skip = .false.
-    if (allocated(r%contact)) call touching(r%contact)
+    if (allocated(r%contact)) then
+      if (.not. r%contact%compliant) call touching(r%contact)
+    end if
     err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd, skip)
     ratio = next_step_ratio(r%sc, err)
     ok = err <= 1 .or. h <= r%sc%dt_min
@@ -830,7 +833,8 @@ contains
       'target in one step; look at the frames there, or take a shorter dt'
   end subroutine warn_energy
 
-  !> The energy balance's terms that the scene has: friction's, moving obstacles'
+  !> The energy balance's terms that the scene has: friction's, moving obstacles', a
+  !> compliant contact's
   function balance_terms(deck, contact) result(terms)
     type(deck_t), intent(in) :: deck
     type(contact_t), intent(in), optional :: contact
@@ -841,6 +845,8 @@ contains
                                                              sum(contact%friction_work))]
     if (moving_obstacles(deck, .true.)) &
       terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
+    if (contact%compliant) terms = [terms, energy_term_t('held in the contact stiffness', &
+                                                         contact_stored_energy(contact))]
   end function balance_terms
 
   logical function moving_obstacles(deck, use_contact)

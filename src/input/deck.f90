@@ -108,6 +108,7 @@ module casca_deck
     integer :: npairs = 0                       !< 0: every pair of bodies
     character(len=64) :: pairs(2, max_pairs) = ''
     real(dp) :: tolerance = 1e-7_dp             !< penetration accepted, relative to scene size
+    real(dp) :: stiffness = unset               !< compliant contact [Pa/m]; unset: hard
     character(len=16) :: solver = 'auto'        !< 'auto', 'schur' or 'saddle' (docs/method.md)
     character(len=16) :: normal = 'nodal'       !< 'nodal' or 'element' (docs/method.md)
     character(len=16) :: surface = 'faces'      !< 'faces' (thickness offset) or 'mid'
@@ -536,14 +537,15 @@ contains
     logical :: enabled
     character(len=long) :: solver, normal, surface
     character(len=256) :: pairs(2, max_pairs)   ! (longer than a name: enough to see one too long)
-    real(dp) :: tolerance, friction, static_friction
+    real(dp) :: tolerance, friction, static_friction, stiffness
     real(dp) :: pair_friction(max_pairs), pair_static_friction(max_pairs)
     character(len=256) :: msg
     integer :: ios, k, passes
     namelist /contact/ enabled, pairs, tolerance, solver, normal, surface, passes, friction, &
-      static_friction, pair_friction, pair_static_friction
+      static_friction, pair_friction, pair_static_friction, stiffness
     associate (c => deck%contact)
       enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver; normal = c%normal
+      stiffness = c%stiffness
       surface = c%surface; passes = c%passes; friction = c%friction; static_friction = c%static_friction
       pair_friction = c%pair_friction; pair_static_friction = c%pair_static_friction
       c%line = line
@@ -553,7 +555,7 @@ contains
       if (ios /= 0) then
         call add_problem(deck, line, '&contact: '//trim(msg)); return
       end if
-      c%enabled = enabled; c%tolerance = tolerance
+      c%enabled = enabled; c%tolerance = tolerance; c%stiffness = stiffness
       call take(deck, line, '&contact: solver', lower(solver), c%solver)
       call take(deck, line, '&contact: normal', lower(normal), c%normal)
       call take(deck, line, '&contact: surface', lower(surface), c%surface)

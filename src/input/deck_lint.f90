@@ -44,6 +44,7 @@ module casca_deck_lint
     key_t('load', 'nodes', 'i'), key_t('load', 'pressure', 'r'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
     key_t('contact', 'normal', 's'), key_t('contact', 'surface', 's'), &
     key_t('contact', 'tolerance', 'r'), key_t('contact', 'friction', 'r'), &
+    key_t('contact', 'stiffness', 'r'), &
     key_t('contact', 'static_friction', 'r'), key_t('contact', 'pair_friction', 'r'), &
     key_t('contact', 'pair_static_friction', 'r'), key_t('contact', 'passes', 'i'), &
     key_t('contact', 'enabled', 'l'), key_t('obstacle', 'name', 's'), &

@@ -203,6 +203,8 @@ contains
       end do
     end do
     call positive(deck%contact%line, '&contact: tolerance', deck%contact%tolerance)
+    if (deck%contact%stiffness /= unset) &
+      call positive(deck%contact%line, '&contact: stiffness', deck%contact%stiffness)
     if (deck%contact%solver /= 'schur' .and. deck%contact%solver /= 'saddle' .and. deck%contact%solver /= 'auto') &
       call add_problem(deck, deck%contact%line, '&contact: solver must be ''auto'', ''schur'' or ''saddle''')
     if (deck%contact%normal /= 'nodal' .and. deck%contact%normal /= 'element') &

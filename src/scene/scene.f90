@@ -13,7 +13,7 @@ module casca_scene
   use casca_newmark, only: state_t
   use casca_vectors, only: cross
   use casca_obstacle, only: obstacle_t
-  use casca_contact, only: contact_t, contact_init
+  use casca_contact, only: contact_t, contact_init, contact_set_stiffness
   use casca_orientation, only: reverse_elements, edge_census_t, edge_census
   use casca_strings, only: itoa, rtoa
   implicit none
@@ -247,6 +247,7 @@ contains
     call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
                       deck%contact%surface == 'faces', c)
     c%nodal_normal = deck%contact%normal == 'nodal'
+    if (deck%contact%stiffness /= unset) call contact_set_stiffness(c, model, deck%contact%stiffness)
     do p = 1, c%npairs
       d = deck%contact%friction; st = deck%contact%static_friction
       t = c%pair(2, p)

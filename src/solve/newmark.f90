@@ -51,8 +51,11 @@ contains
     type(constraint_t), allocatable :: before(:), released(:)
     real(dp) :: dt, g
     integer :: k, iters
+    logical :: compliant
 
     g = nm%gamma; dt = nm%dt
+    compliant = .false.
+    if (present(contact)) compliant = contact%compliant
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
     allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
@@ -60,6 +63,7 @@ contains
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
       contact%x_start = positions(model, st%q); contact%dt = dt
+      contact%alpha_f = nm%alpha_f; contact%act(1:contact%nact)%g0 = contact%act(1:contact%nact)%gap
       contact%g_start = positions(model, st%q, fibres=.true.)   ! (friction's slip)
     end if
     released = [constraint_t ::]
@@ -70,7 +74,9 @@ contains
       end if
       return
     end if
-    if (present(contact) .and. g < 1) then   ! (gamma >= 1: what is left pulls back, dissipates)
+    ! (gamma >= 1: what is left pulls back, dissipates; a compliant contact's force falls to
+    ! zero with its gap before it is released)
+    if (present(contact) .and. g < 1 .and. .not. compliant) then
       do k = 1, size(before)
         if (.not. any(contact%act(1:contact%nact)%node == before(k)%node .and. &
                       contact%act(1:contact%nact)%pair == before(k)%pair)) &
@@ -121,7 +127,8 @@ contains
         call contact_force_points(contact, model, nm%alpha_f, q)
         if (allocated(nu)) deallocate (nu)
         allocate (nu(contact_nrows(contact)))
-        call contact_correction(ls%mass, ls%correction, contact, model, qd, qdd, err, nu)
+        nu = 0   ! (a compliant contact's velocities are the scheme's own: no correction)
+        if (.not. compliant) call contact_correction(ls%mass, ls%correction, contact, model, qd, qdd, err, nu)
         call timer_stop(t_contact)
         if (allocated(err)) return
       end if

@@ -188,8 +188,7 @@ contains
     integer :: nc, info
     nc = size(c%cz, 1)
     if (allocated(c%pivots)) deallocate (c%pivots)
-    c%s = c%cz
-    call sum_all(c%s)
+    call assemble_s()
     if (unsym) then
       c%cholesky = .false.
       allocate (c%pivots(nc))
@@ -206,8 +205,7 @@ contains
       return
     end if
     c%cholesky = .false.   ! not positive definite: S again, into eigenvalues
-    c%s = c%cz
-    call sum_all(c%s)
+    call assemble_s()
     c%s = 0.5_dp*(c%s + transpose(c%s))
     if (allocated(c%eig)) deallocate (c%eig)
     allocate (c%eig(nc), work(max(1, 4*nc)))
@@ -215,6 +213,17 @@ contains
     c%positive = count(c%eig > 0)
     if (info /= 0 .or. minval(abs(c%eig)) <= 1e-12_dp*maxval(abs(c%eig))) call dependent()
   contains
+    !> S = C Z summed over the ranks, less the rows' own diagonal (a compliant row's
+    !> -compliance: the saddle matrix's (2, 2) block), once
+    subroutine assemble_s()
+      integer :: k
+      c%s = c%cz
+      call sum_all(c%s)
+      do k = 1, nc   ! (a row's diagonal is its last entry)
+        c%s(k, k) = c%s(k, k) - c%val(c%first(k + 1) - 1)
+      end do
+    end subroutine assemble_s
+
     subroutine dependent()
       c%current = .false.
       call fatal_error(err, 'contact constraints are dependent (singular Schur complement)')
