@@ -22,6 +22,8 @@ drop      dropped flat at 1 m/s from 0.1 mm, generalized-alpha 0.8, to 1 ms: it 
           With solver 'schur' and 'saddle' the tracked z(t) agree within 1e-10 m. Stopped at
           0.4 ms (in contact) and restarted from its checkpoint, the 10 us run repeats the
           uninterrupted one (z to 1e-12 m).
+check     casca check prints the contact time pi sqrt(rho h / k) = 0.620 ms and the steps of
+          dt in it (1e-4).
 bad input stiffness = -1: exit 2 naming &contact: stiffness.
 """
 import os
@@ -111,6 +113,16 @@ for solver in ("schur", "saddle"):
 if len(zs) == 2:
     ck.le("drop: z(t) with solver 'schur' vs 'saddle' (largest difference) [m]",
           np.abs(zs["schur"] - zs["saddle"]).max(), 1e-10)
+
+# casca check states the contact time pi sqrt(rho h / k) and how many steps it is
+p = run([casca, "check", os.path.join(work, "drop_1e-05.nml")])
+line = [l for l in p.stdout.splitlines() if l.startswith("contact: stiffness")]
+ck.record("check: prints the compliant contact's time", len(line) == 1, p.stdout[-300:])
+if line:
+    t_c = float(line[0].split("= ")[1].split(" s")[0])
+    ck.close("check: contact time [s] vs pi sqrt(rho h / k)", t_c, np.pi / W, 1e-4)
+    ck.close("check: steps of dt in it vs pi sqrt(rho h / k) / dt", float(line[0].split("), ")[1].split(" steps")[0]),
+             np.pi / W / 1e-5, 1e-4)
 
 deck = os.path.join(work, "bad.nml")
 with open(deck, "w") as f:

@@ -6,7 +6,7 @@ module casca_run
   use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
-  use casca_starter, only: put_warnings
+  use casca_starter, only: put_warnings, contact_time
   use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
@@ -820,12 +820,22 @@ contains
     type(run_t), intent(in) :: r
     character(len=:), allocatable :: made
     real(dp) :: e0
+    integer :: b
     e0 = abs(r%bal0%total)
     if (r%restart_step >= 0 .or. .not. r%made_max > 1e-3_dp*max(e0, r%e_scale)) return
     if (e0 >= 1e-3_dp*r%e_scale) then
       made = ftoa(100*r%made_max/e0)//'% of the initial energy'
     else   ! (a scene that starts at rest under its loads)
       made = rtoa(r%made_max)//' J (the bodies held at most '//rtoa(r%e_scale)//' J)'
+    end if
+    if (allocated(r%contact)) then
+      if (r%contact%compliant) then   ! (a spring whose steps are too long for it)
+        write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
+          count_of(r%made_contacts, 'contact', 'contacts')//' active: the compliant contact''s '// &
+          'time pi sqrt(rho h / stiffness) is '//rtoa(contact_time(r%deck, r%model, b)/r%deck%run%dt)// &
+          ' steps of dt for body '''//trim(r%model%body(b)%name)//'''; take a shorter dt or a lower stiffness'
+        return
+      end if
     end if
     write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
       count_of(r%made_contacts, 'contact', 'contacts')//' active: a node that came into a '// &

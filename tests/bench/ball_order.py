@@ -1,6 +1,8 @@
 """The order through contact: a ball dropped on a floor, a ladder of steps per scheme.
 
-usage: ball_order.py CASCA WORK [SCHEME ...]   (SCHEME: 'newmark', 'alpha0.8', 'alpha0'; all by default)
+usage: ball_order.py CASCA WORK [SCHEME ...] [stiffness=K]
+       (SCHEME: 'newmark', 'alpha0.8', 'alpha0', 'alpha1'; the first three by default;
+       stiffness=K: compliant contact, &contact stiffness = K [Pa/m]; default hard)
 
 An aluminium ball R 0.3 m, h 4 mm, 320 elements, its lowest face 1 mm above a rigid plane, at
 8 m/s, 4 ms. Prints per run: the largest error of the lowest (contact) and highest (free)
@@ -15,9 +17,15 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from casca_testlib import history  # noqa: E402
+
 casca, work = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
-schemes = sys.argv[3:] or ["newmark", "alpha0.8", "alpha0"]
-KEYS = {"newmark": "beta = 1.0, gamma = 1.5", "alpha0.8": "rho_inf = 0.8", "alpha0": "rho_inf = 0.0"}
+args = sys.argv[3:]
+CONTACT = "".join("&contact stiffness = %s /\n" % a.split("=")[1] for a in args if a.startswith("stiffness="))
+schemes = [a for a in args if not a.startswith("stiffness=")] or ["newmark", "alpha0.8", "alpha0"]
+KEYS = {"newmark": "beta = 1.0, gamma = 1.5", "alpha0.8": "rho_inf = 0.8", "alpha0": "rho_inf = 0.0",
+        "alpha1": "rho_inf = 1.0"}
 STEPS = [1e-4, 5e-5, 2.5e-5, 1.25e-5, 6.25e-6]
 os.makedirs(work, exist_ok=True)
 mesh = os.path.join(work, "ball.msh")
@@ -36,14 +44,11 @@ def run(scheme, dt):
 &body name = 'ball', mesh = 'file', file = '{mesh}', center = 0.0, 0.0, 0.303,
   velocity = 0.0, 0.0, -8.0, young = 70e9, poisson = 0.33, density = 2700, thickness = 0.004 /
 &obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /
-""")
+{CONTACT}""")
     t0 = time.time()
     subprocess.run([casca, "run", deck, "-q"], check=True)
     wall = time.time() - t0
-    with open(os.path.join(out, "history.dat")) as f:
-        names = f.readline().split()[1:]
-    h = np.loadtxt(os.path.join(out, "history.dat"))
-    h = {n: h[:, i] for i, n in enumerate(names)}
+    h = history(out)
     frames = [np.argmin(abs(h["t"] - k * 1e-4)) for k in range(41)]
     return dict(lo=h["p1_z"][frames], hi=h["p2_z"][frames], pz=h["pz"][-1], e=h["total"][-1] / h["total"][0],
                 wall=wall)
