@@ -254,7 +254,7 @@ contains
   !> the idle bodies' exact advance, the balance, the history row, frames and checkpoints
   subroutine dynamic_run(r)
     type(run_t), intent(inout) :: r
-    real(dp) :: interval, next_frame, next_ckpt, dt
+    real(dp) :: interval, next_frame, next_ckpt
     real(dp), allocatable :: q_before(:), qd_before(:)
     type(state_t) :: st_before
     type(contact_t), allocatable :: contact_before
@@ -270,53 +270,12 @@ contains
     !> surfaces); energy_cut: this step was cut for its energy once already (a half step that
     !> makes energy too is kept: a shorter one made more on a plane pushing a ring)
     logical :: guarded, energy_cut
-    integer :: k
+    call dynamic_start(r, interval, next_frame, next_ckpt)
+    if (r%code /= exit_ok) return
     associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm, rep => r%rep)
-      if (deck%run%rho_inf /= unset) then
-        nm = alpha_scheme(deck%run%rho_inf)
-      else
-        nm = newmark_scheme(deck%run%beta, deck%run%gamma)
-      end if
-      dt = deck%run%dt
-      if (deck%run%tolerance /= unset) then
-        r%sc%tol = deck%run%tolerance
-        r%sc%length = model%length
-        if (deck%run%tolerance_length /= unset) r%sc%length = deck%run%tolerance_length
-        r%sc%dt_min = dt/2**deck%run%max_step_cuts
-        if (r%dt_try == 0) r%dt_try = dt
-      end if
       guarded = .not. (moving_obstacles(deck, allocated(r%contact)) .or. any(model%pressure /= 0))
       energy_cut = .false.
-      interval = deck%output%interval
-      if (interval == unset) interval = deck%run%t_end/100
-      interval = max(interval, dt)
-      next_frame = next_multiple(st%t, interval)
-      next_ckpt = huge(1._dp)
-      if (deck%output%checkpoint_interval > 0) &
-        next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
-      if (r%restart_step < 0) then
-        call start_acceleration(r)
-        call account(model, r%asm, st, r%fext, r%q0, r%bal)
-        r%bal0 = r%bal
-        call watch_energy(r, rest_now(r))
-        call history_row(r, 0)
-        if (failed(r, 'history')) return
-        call frame(r)
-        if (failed(r, 'frame')) return
-      else   ! (the energy before the first step, for the first step's check)
-        call account(model, r%asm, st, r%fext, r%q0, r%bal)
-        r%rest_last = rest_now(r)
-      end if
-      if (is_root() .and. .not. r%quiet) print '(a)', 'casca: '//count_of(model%nbody, 'body', 'bodies')// &
-        ', '//count_of(model%nelem, 'element', 'elements')//', '// &
-        count_of(r%asm%neq_total, 'unknown', 'unknowns')//', '//count_of(n_ranks, 'rank', 'ranks')
-      if (is_root() .and. .not. r%quiet .and. n_ranks > 1) print '(a,*(a,:,"; "))', &
-        'casca: bodies solved on ', (trim(model%body(k)%name)//': '//ranks_of(r, k), k=1, model%nbody)
-
-      r%last = progress_t(r%t0, st%t, st%step, 0)
-      allocate (r%frozen(model%ndof), r%idle(model%nbody))
-      r%frozen = .false.; r%idle = .false.
-      do while (st%t < deck%run%t_end - 1e-6_dp*dt)
+      do while (st%t < deck%run%t_end - 1e-6_dp*deck%run%dt)
         nm%dt = step_length(r, interval)
         if (deck%run%skip_idle_bodies) call update_frozen(r)
         if (allocated(r%err)) then
@@ -364,23 +323,7 @@ contains
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
         call watch_energy(r, rest)
-        call timer_start(t_output)
-        call history_row(r, rep%iters)
-        call timer_stop(t_output)
-        if (failed(r, 'history')) return
-        if (st%t >= next_frame - 1e-6_dp*dt .or. st%t >= deck%run%t_end - 1e-6_dp*dt) then
-          call timer_start(t_output)
-          call frame(r)
-          call timer_stop(t_output)
-          if (failed(r, 'frame')) return
-          next_frame = next_frame + interval
-          if (is_root() .and. .not. r%quiet) call progress(r)
-        end if
-        if (st%t >= next_ckpt - 1e-6_dp*dt) then
-          call checkpoint(r)
-          if (r%code /= exit_ok) return
-          next_ckpt = next_ckpt + deck%output%checkpoint_interval
-        end if
+        if (.not. step_written(r, interval, next_frame, next_ckpt)) return
       end do
     end associate
     call checkpoint(r)
@@ -393,7 +336,7 @@ contains
       r%level = r%level + 1
       r%dt_try = r%nm%dt/2
       if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
-        merge(r%dt_try, dt/2**r%level, r%sc%tol > 0), ': ', why
+        merge(r%dt_try, r%deck%run%dt/2**r%level, r%sc%tol > 0), ': ', why
     end subroutine cut_step
 
     subroutine undo_step()
@@ -408,6 +351,88 @@ contains
                          abs(bal_before%work), abs(r%bal%work))
     end function energy_scale
   end subroutine dynamic_run
+
+  !> Before the first step: the scheme, the error control, the first frame and history row
+  !> (or, at a restart, the energy the first step is judged from), the opening lines, and the
+  !> next frame's and checkpoint's times
+  subroutine dynamic_start(r, interval, next_frame, next_ckpt)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(out) :: interval, next_frame, next_ckpt
+    real(dp) :: dt
+    integer :: k
+    associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm)
+      if (deck%run%rho_inf /= unset) then
+        nm = alpha_scheme(deck%run%rho_inf)
+      else
+        nm = newmark_scheme(deck%run%beta, deck%run%gamma)
+      end if
+      dt = deck%run%dt
+      if (deck%run%tolerance /= unset) then
+        r%sc%tol = deck%run%tolerance
+        r%sc%length = model%length
+        if (deck%run%tolerance_length /= unset) r%sc%length = deck%run%tolerance_length
+        r%sc%dt_min = dt/2**deck%run%max_step_cuts
+        if (r%dt_try == 0) r%dt_try = dt
+      end if
+      interval = deck%output%interval
+      if (interval == unset) interval = deck%run%t_end/100
+      interval = max(interval, dt)
+      next_frame = next_multiple(st%t, interval)
+      next_ckpt = huge(1._dp)
+      if (deck%output%checkpoint_interval > 0) &
+        next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
+      if (r%restart_step < 0) then
+        call start_acceleration(r)
+        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        r%bal0 = r%bal
+        call watch_energy(r, rest_now(r))
+        call history_row(r, 0)
+        if (failed(r, 'history')) return
+        call frame(r)
+        if (failed(r, 'frame')) return
+      else   ! (the energy before the first step, for the first step's check)
+        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        r%rest_last = rest_now(r)
+      end if
+      if (is_root() .and. .not. r%quiet) print '(a)', 'casca: '//count_of(model%nbody, 'body', 'bodies')// &
+        ', '//count_of(model%nelem, 'element', 'elements')//', '// &
+        count_of(r%asm%neq_total, 'unknown', 'unknowns')//', '//count_of(n_ranks, 'rank', 'ranks')
+      if (is_root() .and. .not. r%quiet .and. n_ranks > 1) print '(a,*(a,:,"; "))', &
+        'casca: bodies solved on ', (trim(model%body(k)%name)//': '//ranks_of(r, k), k=1, model%nbody)
+      r%last = progress_t(r%t0, st%t, st%step, 0)
+      allocate (r%frozen(model%ndof), r%idle(model%nbody))
+      r%frozen = .false.; r%idle = .false.
+    end associate
+  end subroutine dynamic_start
+
+  !> After an accepted step: its history row, the frame and progress line when one is due,
+  !> the checkpoint when one is due. False when the run must stop (r%code says why).
+  logical function step_written(r, interval, next_frame, next_ckpt) result(ok)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(in) :: interval
+    real(dp), intent(inout) :: next_frame, next_ckpt
+    real(dp) :: dt
+    ok = .false.
+    dt = r%deck%run%dt
+    call timer_start(t_output)
+    call history_row(r, r%rep%iters)
+    call timer_stop(t_output)
+    if (failed(r, 'history')) return
+    if (r%st%t >= next_frame - 1e-6_dp*dt .or. r%st%t >= r%deck%run%t_end - 1e-6_dp*dt) then
+      call timer_start(t_output)
+      call frame(r)
+      call timer_stop(t_output)
+      if (failed(r, 'frame')) return
+      next_frame = next_frame + interval
+      if (is_root() .and. .not. r%quiet) call progress(r)
+    end if
+    if (r%st%t >= next_ckpt - 1e-6_dp*dt) then
+      call checkpoint(r)
+      if (r%code /= exit_ok) return
+      next_ckpt = next_ckpt + r%deck%output%checkpoint_interval
+    end if
+    ok = .true.
+  end function step_written
 
   !> Statics: load steps of the dead loads; one history row and frame per load step
   !> (t = load factor).
