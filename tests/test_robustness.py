@@ -3,14 +3,17 @@
 usage: test_robustness.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR [CASE ...]
   CASE (default all): shipped slit oblique plate_strike trapezoidal rim resting
 
-shipped      every deck in examples/ runs to its end with exit 0. test_scenes.py runs
+shipped      every deck in examples/ runs to its end with exit 0 (ball_bounce: its total
+             energy, with what the compliant contact holds, within 1e-3 of E0 at every step,
+             the contact over at the end and the ball going up). test_scenes.py runs
              strip_wall, two_rings and three_rings whole (exit 0 asserted there), and
              three_spheres for its first 1.2 ms only (the whole scene takes 2 to 5 minutes on
              2 ranks: no test runs it to the end); test_cli.py only checks the decks. Every
              other deck is run here, from a copy: today that is cantilever.nml (statics, Sze's
              cantilever under end shear), whose tip deflections at P = 4 are compared with Sze,
-             Liu & Lo (2004), and hoop_rolling.nml (exit 0 here; its physics, the same scene, is
-             asserted in test_friction.py).
+             Liu & Lo (2004), hoop_rolling.nml (exit 0 here; its physics, the same scene, is
+             asserted in test_friction.py) and ball_bounce.nml (compliant contact; its order
+             through contact is asserted on a plate in test_compliant_contact.py).
 slit         statics with large rotations from the default Newton settings: Sze's slit annular
              plate under an end line force (test 3.3), built here (tests/data/
              make_slit_annular_plate.py), 40 load steps; W_A and W_B at q = 0.2, 0.4 and 0.8
@@ -175,6 +178,13 @@ if "shipped" in CASES:
                      6.698, 0.01)
             ck.close("cantilever: tip -U at P = 4 vs Sze et al. 2004 (3.286)", 10.0 - h["p1_x"][-1],
                      3.286, 0.01)
+        if d == "ball_bounce" and ok:
+            # an elastic ball on an elastic (compliant) floor: nothing but the scheme takes
+            # energy out, and nothing may put any in
+            ck.le("ball_bounce: the total energy (the contact's held energy with it) within 1e-3 of E0 "
+                  "at every step (max |E / E0 - 1|)", np.abs(h["total"] / h["total"][0] - 1).max(), 1e-3)
+            ck.record("ball_bounce: the contact ends and the ball leaves upwards",
+                      h["contacts"][-1] == 0 and h["pz"][-1] > 0 and h["contacts"].max() > 0)
     timings["shipped"] = time.time() - t0
 
 # --- 2 and 6. slit annular plate, statics from the defaults -------------------------------

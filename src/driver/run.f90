@@ -303,7 +303,7 @@ contains
         end if
         if (any(r%idle)) call advance_idle(model, r%idle, nm%dt, q_before, qd_before, st%q, st%qd, st%qdd)
         call timer_start(t_account)
-        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        call account_state(r)
         call timer_stop(t_account)
         rest = rest_now(r)
         made = r%rest_last - rest
@@ -383,7 +383,7 @@ contains
         next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
       if (r%restart_step < 0) then
         call start_acceleration(r)
-        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        call account_state(r)
         r%bal0 = r%bal
         call watch_energy(r, rest_now(r))
         call history_row(r, 0)
@@ -391,7 +391,7 @@ contains
         call frame(r)
         if (failed(r, 'frame')) return
       else   ! (the energy before the first step, for the first step's check)
-        call account(model, r%asm, st, r%fext, r%q0, r%bal)
+        call account_state(r)
         r%rest_last = rest_now(r)
       end if
       if (is_root() .and. .not. r%quiet) print '(a)', 'casca: '//count_of(model%nbody, 'body', 'bodies')// &
@@ -447,7 +447,7 @@ contains
           call give_up(r, r%err%message); return
         end if
         st%t = real(i, dp)/deck%run%load_steps; st%step = i
-        call account(r%model, r%asm, st, r%fext*st%t, r%q0, r%bal, factor=st%t)   ! (issue 17)
+        call account_state(r, factor=st%t)   ! (issue 17)
         call history_row(r, r%rep%iters)
         if (failed(r, 'history')) return
         call frame(r)
@@ -824,6 +824,19 @@ contains
     r%rest_last = rest
     r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
   end subroutine watch_energy
+
+  !> The run's energies and momenta now (accounting.f90); the total holds a compliant contact's
+  !> energy too, as a spring's (the balance's remainder counts it as a term of its own)
+  subroutine account_state(r, factor)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(in), optional :: factor   !< statics: the load factor
+    if (present(factor)) then
+      call account(r%model, r%asm, r%st, r%fext*factor, r%q0, r%bal, factor=factor)
+    else
+      call account(r%model, r%asm, r%st, r%fext, r%q0, r%bal)
+    end if
+    if (allocated(r%contact)) r%bal%total = r%bal%total + contact_stored_energy(r%contact)
+  end subroutine account_state
 
   !> energy_balance's remainder at the run's state: E0 less what the bodies hold and the
   !> terms taken out (what the integrator and the contact removed so far)
