@@ -5,7 +5,8 @@ speed (the thesis' Figs. 8 and 14). Run with ParaView's batch interpreter:
 
 writes out/two_rings/frame_t<time>.png for each time (the nearest frame's time, 6 digits). Every picture has
 the same camera and colour range, so that they compare: the camera looks along the thinnest
-side of the box holding all bodies in all the chosen frames (down the axis of the rings),
+side of the box holding all bodies in all the chosen frames (down the axis of the rings; when
+no side is under half the longest, as for a ball, along y with z up),
 with the box's longest side across the picture, and shows the whole box; the colours run
 from 0 to the highest speed in those frames."""
 import math
@@ -45,6 +46,8 @@ def place_camera(view, box):
     centre = [0.5 * (box[2 * i] + box[2 * i + 1]) for i in range(3)]
     size = [box[2 * i + 1] - box[2 * i] for i in range(3)]
     thin, up, across = sorted(range(3), key=lambda i: size[i])
+    if size[thin] > 0.5 * size[across]:   # no side much thinner (a ball): a side view, z up
+        thin, up, across = 1, 2, 0
     half = 0.5 * MARGIN * max(size[up], size[across] * HEIGHT / WIDTH, 1e-12)
     distance = half / math.tan(math.radians(0.5 * view.CameraViewAngle)) + 0.5 * size[thin]
     # from +thin, looking along -thin with `up` up, the right-hand side is (-thin) x up:
