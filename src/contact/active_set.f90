@@ -4,7 +4,7 @@ module casca_contact_active_set
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
-  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick
+  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry
   use casca_contact_friction, only: friction_on, friction_update
   implicit none
@@ -68,7 +68,7 @@ contains
         do n = model%body(bi)%node_first, model%body(bi)%node_last
           call obstacle_point(c%obstacle(-bt), c%time, x(:, n), nrm, d)
           if (d > reach) cycle
-          if (is_active(n, ip) .or. all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
+          if (holds(c, n, ip) .or. all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
           cn = constraint_t(node=n, pair=ip)
           call take(cn)
         end do
@@ -85,7 +85,7 @@ contains
       reach = face_reach(c, model, bi, bt) + 0.25_dp*c%geo%depth(bt)
       do n = model%body(bi)%node_first, model%body(bi)%node_last
         if (any(x(:, n) > boxt(:, 2) + r) .or. any(x(:, n) < boxt(:, 1) - r)) cycle
-        if (is_active(n, ip)) cycle
+        if (holds(c, n, ip)) cycle
         call project(c, model, x, n, ip, cn, found)
         if (.not. found) cycle
         if (cn%sd >= reach .or. .not. has_free_position(n, cn%elem)) cycle
@@ -105,17 +105,6 @@ contains
         added = added + 1
       end if
     end subroutine take
-
-    logical function is_active(node, p)
-      integer, intent(in) :: node, p
-      integer :: j
-      is_active = .false.
-      do j = 1, c%nact
-        if (c%act(j)%node == node .and. c%act(j)%pair == p) then
-          is_active = .true.; return
-        end if
-      end do
-    end function is_active
 
     !> a constraint needs at least one free position on either side
     logical function has_free_position(node, e)

@@ -16,7 +16,7 @@ module casca_contact
   implicit none
   private
   public :: contact_t, constraint_t, target_geometry_t, contact_init, face_reach, search_radius
-  public :: contact_set_stiffness, normal_compliance, normal_residual
+  public :: contact_set_stiffness, normal_compliance, normal_residual, holds
 
   type :: constraint_t
     integer :: node = 0, pair = 0
@@ -206,6 +206,13 @@ contains
     c%compliance = 1/(stiffness*max(area, tiny(1._dp)))
     c%compliant = .true.
   end subroutine contact_set_stiffness
+
+  !> Whether the active set holds a constraint of node on pair p
+  pure logical function holds(c, node, p)
+    type(contact_t), intent(in) :: c
+    integer, intent(in) :: node, p
+    holds = any(c%act(1:c%nact)%node == node .and. c%act(1:c%nact)%pair == p)
+  end function holds
 
   !> The compliance of constraint a's normal row as the row carries it [m/N] (0: hard). The
   !> time scheme takes forces at its alpha level, so a compliant force is lambda =

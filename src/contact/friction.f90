@@ -13,7 +13,7 @@
 !> and adds its force times its slip to the pair's dissipated energy.
 module casca_contact_friction
   use casca_kinds, only: dp
-  use casca_contact, only: contact_t, constraint_t, stick, slip
+  use casca_contact, only: contact_t, constraint_t, stick, slip, holds
   use casca_contact_rows, only: friction_force
   use casca_time_scheme, only: scheme_t
   implicit none
@@ -75,7 +75,7 @@ contains
     ! hands its contact from node to node): along its slip of the step before
     do k = 1, size(before)
       associate (b => before(k))
-        if (b%grip /= slip .or. any(c%act(1:c%nact)%node == b%node .and. c%act(1:c%nact)%pair == b%pair)) cycle
+        if (b%grip /= slip .or. holds(c, b%node, b%pair)) cycle
         c%friction_work(b%pair) = c%friction_work(b%pair) - dot_product((1 - w)*b%fa, b%ut)
       end associate
     end do

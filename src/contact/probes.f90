@@ -3,7 +3,7 @@
 module casca_contact_probes
   use casca_kinds, only: dp
   use casca_model, only: model_t
-  use casca_contact, only: contact_t, search_radius
+  use casca_contact, only: contact_t, search_radius, holds
   use casca_contact_active_set, only: contact_update
   implicit none
   private
@@ -25,8 +25,7 @@ contains
     call contact_update(probe, model, q, .true., added, .false.)
     free_pen = 0
     do k = 1, probe%nact
-      if (any(c%act(1:c%nact)%node == probe%act(k)%node .and. &
-              c%act(1:c%nact)%pair == probe%act(k)%pair)) cycle
+      if (holds(c, probe%act(k)%node, probe%act(k)%pair)) cycle
       free_pen = max(free_pen, -probe%act(k)%gap)
     end do
     max_gap = 0

@@ -468,13 +468,14 @@ contains
   real(dp) function step_length(r, interval) result(h)
     type(run_t), intent(inout) :: r
     real(dp), intent(in) :: interval
-    real(dp) :: hit
+    real(dp) :: hit, to_grid
     associate (st => r%st, t_end => r%deck%run%t_end)
       if (r%sc%tol <= 0) then
         h = r%deck%run%dt/2**r%level
         ! off its own grid (grown back after a cut): to the grid, so that the steps land on the
         ! deck's dt again and the frames on their times (on it: h itself, as a restart does)
-        if (next_multiple(st%t, h) - st%t < (1 - 1e-6_dp)*h) h = next_multiple(st%t, h) - st%t
+        to_grid = next_multiple(st%t, h) - st%t
+        if (to_grid < (1 - 1e-6_dp)*h) h = to_grid
         h = min(h, t_end - st%t)
         return
       end if
@@ -856,7 +857,7 @@ contains
   !> makes energy, so it is the contact's doing
   subroutine warn_energy(r)
     type(run_t), intent(in) :: r
-    character(len=:), allocatable :: made
+    character(len=:), allocatable :: made, why
     real(dp) :: e0
     integer :: b
     e0 = abs(r%bal0%total)
@@ -866,19 +867,16 @@ contains
     else   ! (a scene that starts at rest under its loads)
       made = rtoa(r%made_max)//' J (the bodies held at most '//rtoa(r%e_scale)//' J)'
     end if
+    why = 'a node that came into a shell edge-on, through its rim (casca has no edge-to-edge '// &
+          'contact), or deep into a target in one step; look at the frames there, or take a shorter dt'
     if (allocated(r%contact)) then
-      if (r%contact%compliant) then   ! (a spring whose steps are too long for it)
-        write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
-          count_of(r%made_contacts, 'contact', 'contacts')//' active: the compliant contact''s '// &
-          'time pi sqrt(rho h / stiffness) is '//rtoa(contact_time(r%deck, r%model, b)/r%deck%run%dt)// &
-          ' steps of dt for body '''//trim(r%model%body(b)%name)//'''; take a shorter dt or a lower stiffness'
-        return
-      end if
+      if (r%contact%compliant) &   ! (a spring whose steps are too long for it)
+        why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &
+              rtoa(contact_time(r%deck, r%model, b)/r%deck%run%dt)//' steps of dt for body '''// &
+              trim(r%model%body(b)%name)//'''; take a shorter dt or a lower stiffness'
     end if
     write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
-      count_of(r%made_contacts, 'contact', 'contacts')//' active: a node that came into a '// &
-      'shell edge-on, through its rim (casca has no edge-to-edge contact), or deep into a '// &
-      'target in one step; look at the frames there, or take a shorter dt'
+      count_of(r%made_contacts, 'contact', 'contacts')//' active: '//why
   end subroutine warn_energy
 
   !> The energy balance's terms that the scene has: friction's, moving obstacles', a

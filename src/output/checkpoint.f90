@@ -118,6 +118,7 @@ contains
     real(dp), allocatable :: reals(:)
     integer :: k, nact, node, pair, per
     character(len=:), allocatable :: bad
+    logical :: with_fa
 
     level = 0
     call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next)
@@ -223,6 +224,7 @@ contains
         contact%g_start = positions(model, st%q, fibres=.true.)
       end if
     end if
+    with_fa = size(reals) == 14*int(nact, int64) + 7*contact%npairs + 1   ! (friction's start forces)
     do k = 1, nact
       contact%act(k) = constraint_t(node=ints(3 + per*(k - 1)), pair=ints(4 + per*(k - 1)))
       contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
@@ -236,9 +238,11 @@ contains
         contact%act(k)%xi = r(1:2); contact%act(k)%lt = r(3:4); contact%act(k)%mut = r(5:6)
         contact%act(k)%s = r(7:9)
       end associate
-      associate (at => 11*nact + 7*contact%npairs + 1 + 3*(k - 1))
-        if (size(reals) == at - 3*(k - 1) + 3*nact) contact%act(k)%fa = reals(at + 1:at + 3)
-      end associate
+      if (with_fa) then
+        associate (at => 11*nact + 7*contact%npairs + 1 + 3*(k - 1))
+          contact%act(k)%fa = reals(at + 1:at + 3)
+        end associate
+      end if
       ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
       ! that wrote it left them
       if (contact%act(k)%elem > 0 .or. contact%pair(2, contact%act(k)%pair) <= 0) &

@@ -8,7 +8,7 @@ module casca_newmark
   use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t, constraint_t
+  use casca_contact, only: contact_t, constraint_t, holds
   use casca_contact_correction, only: contact_correction, add_impulses
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
@@ -78,9 +78,7 @@ contains
     ! zero with its gap before it is released)
     if (present(contact) .and. g < 1 .and. .not. compliant) then
       do k = 1, size(before)
-        if (.not. any(contact%act(1:contact%nact)%node == before(k)%node .and. &
-                      contact%act(1:contact%nact)%pair == before(k)%pair)) &
-          released = [released, before(k)]
+        if (.not. holds(contact, before(k)%node, before(k)%pair)) released = [released, before(k)]
       end do
       if (size(released) > 0) then
         call timer_start(t_contact)
