@@ -102,3 +102,21 @@ def spinning_plate_deck(solver, run_extra=""):
 &obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /
 &contact solver = '%s' /
 """ % (run_extra, solver)
+
+
+def svk_sphere_stretch(p, young, nu, h, radius):
+    """r/R of a thin closed sphere of the 3D Saint Venant-Kirchhoff law with S33 = 0 under a
+    mid-surface (follower) pressure p: p = 2 S11(lambda) h / (lambda R), by bisection"""
+    lam_l = young * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = young / (2 * (1 + nu))
+
+    def excess(s):
+        e11 = (s * s - 1) / 2
+        e33 = -lam_l * 2 * e11 / (lam_l + 2 * mu)
+        s11 = lam_l * (2 * e11 + e33) + 2 * mu * e11
+        return 2 * s11 * h / (s * radius) - p
+    a, b = 1.0, 2.0
+    for _ in range(200):
+        m = (a + b) / 2
+        a, b = (a, m) if excess(m) > 0 else (m, b)
+    return (a + b) / 2

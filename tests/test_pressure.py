@@ -31,7 +31,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, run, run_scene
+from casca_testlib import Checks, history, run, run_scene, svk_sphere_stretch
 
 E, NU, RHO, H, R = 2.0e11, 0.3, 7800.0, 0.005, 1.0
 
@@ -64,20 +64,8 @@ def radii(h):
 
 
 def svk_stretch(p):
-    """r/R of a thin sphere of the 3D SVK law with S33 = 0, mid-surface pressure p (bisection)"""
-    lam_l = E * NU / ((1 + NU) * (1 - 2 * NU))
-    mu = E / (2 * (1 + NU))
-
-    def excess(s):
-        e11 = (s * s - 1) / 2
-        e33 = -lam_l * 2 * e11 / (lam_l + 2 * mu)
-        s11 = lam_l * (2 * e11 + e33) + 2 * mu * e11
-        return 2 * s11 * H / (s * R) - p
-    a, b = 1.0, 2.0
-    for _ in range(200):
-        m = (a + b) / 2
-        a, b = (a, m) if excess(m) > 0 else (m, b)
-    return (a + b) / 2
+    """r/R of this sphere under mid-surface pressure p (casca_testlib.svk_sphere_stretch)"""
+    return svk_sphere_stretch(p, E, NU, H, R)
 
 
 def orientation(casca, ck, work):

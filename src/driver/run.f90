@@ -6,13 +6,14 @@ module casca_run
   use casca_deck, only: deck_t, read_deck, unset, add_problem
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
-  use casca_starter, only: put_warnings, contact_time
+  use casca_starter, only: put_warnings, contact_time, static_warnings
   use casca_model, only: model_t, reference_state, dof
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
   use casca_mass_solver, only: mass_setup
   use casca_newton, only: newton_opts_t, newton_report_t
-  use casca_newmark, only: state_t, newmark_step, static_solve
+  use casca_newmark, only: state_t, newmark_step
+  use casca_statics, only: static_solve
   use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
   use casca_step_control, only: step_control_t, local_error, next_step_ratio
   use casca_step_size, only: time_to_contact
@@ -226,6 +227,7 @@ contains
       r%fext = r%fext + model%fext
       call tracked_nodes(deck, model, r%tracked, far)
       if (is_root()) call put_warnings(far, 0)
+      if (is_root()) call put_warnings(static_warnings(deck), 0)
       allocate (r%labels(size(r%tracked)))
       do k = 1, size(r%tracked)
         associate (b => model%body(model%node_body(r%tracked(k))))
@@ -435,14 +437,19 @@ contains
   end function step_written
 
   !> Statics: load steps of the dead loads; one history row and frame per load step
-  !> (t = load factor).
+  !> (t = load factor), a checkpoint at every multiple of checkpoint_interval (of the load
+  !> factor); a restart goes on from the checkpoint's load step.
   subroutine static_run(r)
     type(run_t), intent(inout) :: r
-    integer :: i
+    integer :: i, stabilised
+    real(dp) :: next_ckpt
     associate (deck => r%deck, st => r%st)
-      do i = 1, deck%run%load_steps
+      next_ckpt = huge(1._dp)
+      if (deck%output%checkpoint_interval > 0) &
+        next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
+      do i = st%step + 1, deck%run%load_steps
         call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/deck%run%load_steps, &
-                          deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, r%contact)
+                          deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, stabilised, r%contact)
         if (allocated(r%err)) then
           call give_up(r, r%err%message); return
         end if
@@ -452,8 +459,14 @@ contains
         if (failed(r, 'history')) return
         call frame(r)
         if (failed(r, 'frame')) return
-        if (is_root() .and. .not. r%quiet) print '(a,i4,a,f6.3,a,i3)', 'load step', i, &
-          '  factor', st%t, '  newton', r%rep%iters
+        if (is_root() .and. .not. r%quiet) print '(a,i4,a,f6.3,a,i3,a)', 'load step', i, &
+          '  factor', st%t, '  newton', r%rep%iters, &
+          trim(merge('  stabilised', '            ', stabilised > 0))
+        if (st%t >= next_ckpt - 1e-9_dp .and. i < deck%run%load_steps) then
+          call checkpoint(r)
+          if (r%code /= exit_ok) return
+          next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
+        end if
       end do
     end associate
     call checkpoint(r)
@@ -593,15 +606,17 @@ contains
   end function ranks_of
 
   !> The deck's contact (none: r%contact stays unallocated); K is block diagonal by body
-  !> unless the constraints are factorised with it ('saddle')
+  !> unless the constraints are factorised with it ('saddle', and 'auto' in statics)
   subroutine setup_contact(r)
     type(run_t), intent(inout) :: r
     logical :: use_contact
     allocate (r%contact)
     call scene_contact(r%deck, r%model, r%contact, use_contact)
     if (.not. use_contact) deallocate (r%contact)
-    r%ls%schur = .not. use_contact .or. r%deck%contact%solver /= 'saddle'
-    r%ls%auto = use_contact .and. r%deck%contact%solver == 'auto'
+    ! (statics: a body held by its contacts alone leaves K singular, not the saddle matrix)
+    r%ls%schur = .not. use_contact .or. r%deck%contact%solver == 'schur' .or. &
+                 (r%deck%contact%solver == 'auto' .and. r%deck%run%analysis /= 'static')
+    r%ls%auto = use_contact .and. r%deck%contact%solver == 'auto' .and. r%deck%run%analysis /= 'static'
     if (use_contact .and. r%deck%run%analysis /= 'static') call mass_setup(r%model, r%ls%mass, r%err)
   end subroutine setup_contact
 

@@ -37,6 +37,7 @@ module casca_starter
   implicit none
   private
   public :: body_facts_t, body_facts, starter_report, thickness_frequency, put_warnings, contact_time
+  public :: static_warnings
 
   !> Below this element quality a warning names the element: the area scale of its map then
   !> varies by more than a factor 2 over it
@@ -162,9 +163,32 @@ contains
     if (deck%run%analysis == 'dynamic') call time_line(deck, model, out)
     call put_warnings(body_warnings(model, f), err)
     call put_warnings(pair_warnings(deck, model), err)
+    call put_warnings(static_warnings(deck), err)
     call tracked_nodes(deck, model, tracked, far)
     call put_warnings(far, err)
   end subroutine starter_report
+
+  !> What statics leave out of a deck that gives it: friction (the stick/slip of a load
+  !> increment is not modelled: contacts are frictionless) and the obstacles' motion (they
+  !> stay where they are at t = 0)
+  function static_warnings(deck) result(w)
+    type(deck_t), intent(in) :: deck
+    character(len=400), allocatable :: w(:)
+    integer :: k
+    allocate (w(0))
+    if (deck%run%analysis /= 'static') return
+    if (deck%contact%friction > 0 .or. any(deck%contact%pair_friction > 0) .or. &
+        (deck%contact%static_friction /= unset .and. deck%contact%static_friction > 0) .or. &
+        any(deck%contact%pair_static_friction /= unset .and. deck%contact%pair_static_friction > 0) .or. &
+        any(deck%obstacles%friction /= unset .and. deck%obstacles%friction > 0)) &
+      w = [character(len=400) :: w, 'statics model no friction: the contacts are frictionless '// &
+           '(friction acts in dynamic runs); hold the bodies sideways by restraints']
+    do k = 1, size(deck%obstacles)
+      if (any(deck%obstacles(k)%velocity /= 0)) w = [character(len=400) :: w, 'obstacle '''// &
+        trim(deck%obstacles(k)%name)//''' has a velocity, but in statics the obstacles stay '// &
+        'where they are at t = 0']
+    end do
+  end function static_warnings
 
   !> The warning lines w, each 'warning: ...', to unit u
   subroutine put_warnings(w, u)

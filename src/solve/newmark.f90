@@ -1,5 +1,5 @@
 !> Time stepping (thesis section 3.2: Newmark; or generalized-alpha, casca_time_scheme) with
-!> Newton at every step, and load-stepped statics. The mass is constant, so the inertia enters
+!> Newton at every step (statics: casca_statics). The mass is constant, so the inertia enters
 !> the residual as M (cm q - qs).
 module casca_newmark
   use casca_kinds, only: dp
@@ -17,7 +17,7 @@ module casca_newmark
   use casca_time_scheme, only: scheme_t
   implicit none
   private
-  public :: state_t, newmark_step, static_solve
+  public :: state_t, newmark_step
 
   type :: state_t
     real(dp) :: t = 0
@@ -135,46 +135,4 @@ contains
       end where
     end subroutine attempt
   end subroutine newmark_step
-
-  !> Statics: the dead load fext scaled from factor from to factor to, in one increment if
-  !> Newton converges, else in halved increments (at most max_cuts halvings), growing back
-  !> after easy ones. q holds the start and the result; on failure it is the last converged
-  !> state and err says at which factor.
-  subroutine static_solve(model, asm, ls, fext, from, to, max_cuts, opts, q, rep, err, contact)
-    type(model_t), intent(in) :: model
-    type(assembly_t), intent(inout) :: asm
-    type(linear_system_t), intent(inout) :: ls
-    real(dp), intent(in) :: fext(:), from, to
-    integer, intent(in) :: max_cuts
-    type(newton_opts_t), intent(in) :: opts
-    real(dp), intent(inout) :: q(:)
-    type(newton_report_t), intent(out) :: rep
-    type(error_t), allocatable, intent(out) :: err
-    type(contact_t), intent(inout), optional :: contact
-    real(dp) :: at, step
-    integer :: level, iters
-    character(len=120) :: msg
-    at = from; level = 0; iters = 0
-    do while (at < to - 1e-12_dp*abs(to - from))
-      step = min((to - from)/2**level, to - at)
-      call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
-                        load_factor=at + step)   ! the pressures scaled too (issue 17)
-      if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
-      if (allocated(err)) then
-        if (level >= max_cuts) then
-          write (msg, '(a,g0.6,a,i0,a)') 'static Newton did not converge at load factor ', &
-            at + step, ' (after ', level, ' halvings of the load step): '
-          err%message = trim(msg)//err%message
-          return
-        end if
-        level = level + 1   ! q is unchanged: half the increment
-        deallocate (err)
-        cycle
-      end if
-      iters = iters + rep%iters
-      at = at + step
-      if (level > 0 .and. rep%iters <= 4) level = level - 1   ! Newton is at ease: grow back
-    end do
-    rep%iters = iters
-  end subroutine static_solve
 end module casca_newmark

@@ -57,6 +57,7 @@ module casca_newton
     real(dp) :: incr(max_hist) = 0    !< max |dq| / scene size of each kept increment
     real(dp) :: energy = 0            !< strain energy at the last assembled iterate
     real(dp) :: residual = 0          !< estimated |R| / scene force at the converged iterate
+    real(dp) :: force_scale = 0       !< the scene's force it was judged against [N]
     integer :: neg_pivots = 0         !< of the factors in use (inertia)
     integer :: analyses = 0           !< symbolic analyses done in this solve
     integer :: factorisations = 0     !< numerical factorisations done in this solve
@@ -153,6 +154,7 @@ contains
       if (gap_open()) cycle
       rep%converged = .true.
       rep%residual = residual_estimate()/max(fref, tiny(1._dp))
+      rep%force_scale = fref
       rep%neg_pivots = negative_pivots(ls, asm, nc)
       return
     end do

@@ -1,0 +1,210 @@
+!> Load-stepped statics, with a viscous path to an equilibrium that only contact holds.
+!>
+!> A body held by contact alone (a plate laid on a floor, a ball resting in a cup) has no
+!> stiffness against its rigid motions until its contacts close, so Newton's tangent is
+!> singular and no halving of the load cures it. A load increment Newton fails is taken
+!> again by pseudo-transient continuation (Kelley & Keyes 1998), the idea of Abaqus/Standard's
+!> automatic stabilisation: stages with a stabilising force c M (q - q_n), q_n the state the
+!> stage starts from, as damped pseudo-time steps. The bodies move towards their contacts and
+!> settle on them. Each stage that converges starts the next from its state with c ten times
+!> lower (longer pseudo-steps); one that does not is taken again with c ten times higher.
+!> When the stabilising force is within Newton's own force tolerance the bodies have stopped:
+!> a last Newton solve without it gives the equilibrium exactly where the equilibrium is
+!> regular, and where it is not (a frictionless body free to slide under no sideways load)
+!> the stabilised state stands, in equilibrium within the tolerance. A body that nothing holds
+!> against its load never stops (the damping goes on carrying a part of the load), and is an
+!> error naming it.
+module casca_statics
+  use casca_kinds, only: dp
+  use casca_error, only: error_t, fatal_error
+  use casca_model, only: model_t
+  use casca_shell_element, only: ndof_node
+  use casca_assembly, only: assembly_t, assemble
+  use casca_linear_system, only: linear_system_t
+  use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
+  use casca_contact, only: contact_t, constraint_t
+  implicit none
+  private
+  public :: static_solve
+
+  integer, parameter :: max_stages = 40      !< stabilised stages of one load step
+  real(dp), parameter :: stage_factor = 10    !< c's change from stage to stage
+  real(dp), parameter :: max_damping = 1e4    !< c at most this times the first stage's
+  real(dp), parameter :: unheld_part = 1e-3   !< of the scene's force the damping carries
+
+contains
+
+  !> Statics: the dead load fext scaled from factor from to factor to, in one increment if
+  !> Newton converges, else stabilised, else in halved increments (at most max_cuts
+  !> halvings), growing back after easy ones. q holds the start and the result; on failure
+  !> it is the last converged state and err says at which factor.
+  subroutine static_solve(model, asm, ls, fext, from, to, max_cuts, opts, q, rep, err, &
+                          stabilised, contact)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    type(linear_system_t), intent(inout) :: ls
+    real(dp), intent(in) :: fext(:), from, to
+    integer, intent(in) :: max_cuts
+    type(newton_opts_t), intent(in) :: opts
+    real(dp), intent(inout) :: q(:)
+    type(newton_report_t), intent(out) :: rep
+    type(error_t), allocatable, intent(out) :: err
+    integer, intent(out) :: stabilised   !< increments that took the stabilised path
+    type(contact_t), intent(inout), optional :: contact
+    real(dp) :: at, step
+    integer :: level, iters
+    logical :: unheld
+    character(len=120) :: msg
+    at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0
+    do while (at < to - 1e-12_dp*abs(to - from))
+      step = min((to - from)/2**level, to - at)
+      call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
+                        load_factor=at + step)   ! the pressures scaled too (issue 17)
+      if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
+      if (allocated(err)) then   ! (first taken to be a body that nothing holds yet)
+        iters = iters + rep%iters
+        deallocate (err)
+        call stabilised_solve(model, asm, ls, fext*(at + step), at + step, opts, q, rep, err, &
+                              unheld, contact)
+        if (.not. allocated(err)) stabilised = stabilised + 1
+      end if
+      iters = iters + rep%iters
+      if (allocated(err)) then
+        if (level >= max_cuts .or. unheld) then   ! (a smaller load does not hold a body)
+          write (msg, '(a,g0.6,a,i0,a)') 'static Newton did not converge at load factor ', &
+            at + step, ' (after ', level, ' halvings of the load step): '
+          err%message = trim(msg)//' '//err%message
+          return
+        end if
+        level = level + 1   ! q is unchanged: half the increment
+        deallocate (err)
+        cycle
+      end if
+      at = at + step
+      if (level > 0 .and. rep%iters <= 4) level = level - 1   ! Newton is at ease: grow back
+    end do
+    rep%iters = iters
+  end subroutine static_solve
+
+  !> One load step through stabilised stages (module comment); unheld: a body kept moving.
+  !> On failure q and the contact's active set are as they were at entry.
+  subroutine stabilised_solve(model, asm, ls, fext, factor, opts, q, rep, err, unheld, contact)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    type(linear_system_t), intent(inout) :: ls
+    real(dp), intent(in) :: fext(:), factor
+    type(newton_opts_t), intent(in) :: opts
+    real(dp), intent(inout) :: q(:)
+    type(newton_report_t), intent(out) :: rep
+    type(error_t), allocatable, intent(out) :: err
+    logical, intent(out) :: unheld
+    type(contact_t), intent(inout), optional :: contact
+    real(dp), allocatable :: q_entry(:), q_n(:)
+    type(constraint_t), allocatable :: act_entry(:)
+    type(newton_opts_t) :: fresh
+    real(dp) :: c, c0, c_fail, fs, travel
+    integer :: stage, iters, moving, k
+    character(len=300) :: msg
+
+    allocate (q_entry, source=q)   ! (explicitly: gcc 12 warned of the descriptor)
+    q_n = q
+    if (present(contact)) act_entry = contact%act(1:contact%nact)
+    c0 = stabilisation(model); c = c0
+    fresh = opts
+    fresh%reuse = .false.   ! (kept factors are of another c, or of the singular tangent)
+    fresh%max_iter = min(opts%max_iter, 10)   ! (a stage that struggles: shorter pseudo-steps)
+    iters = 0; moving = 0; fs = 0; c_fail = 0; unheld = .false.
+    do stage = 1, max_stages
+      call newton_solve(model, asm, ls, q, fext, fresh, rep, err, cm=c, qs=c*q_n, &
+                        contact=contact, load_factor=factor)
+      iters = iters + rep%iters
+      if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
+      if (allocated(err)) then   ! a shorter pseudo-step, and none as long again
+        c_fail = max(c_fail, c)
+        c = c*stage_factor
+        if (c > max_damping*c0) exit
+        deallocate (err)
+        cycle
+      end if
+      call stabilising_force(model, asm, q, q_n, c, fs, moving)
+      if (fs <= opts%force_tol*rep%force_scale) then
+        call unstabilised(iters)
+        rep%iters = iters
+        return
+      end if
+      fs = fs/rep%force_scale
+      q_n = q; c = max(c/stage_factor, 2*c_fail)
+    end do
+    ! (stages converged, and the damping still carries a part of the scene's force: it holds
+    ! what nothing else does; a body settling slowly leaves it a vanishing part)
+    if (moving > 0 .and. fs > unheld_part) then
+      if (allocated(err)) deallocate (err)
+      unheld = .true.
+      travel = 0
+      do k = 1, 3   ! (the mid-surface's positions)
+        travel = max(travel, maxval(abs(q(k::ndof_node) - q_entry(k::ndof_node))))
+      end do
+      write (msg, '(3a,es9.2,a,es9.2,a)') 'no equilibrium: body ''', model%body(moving)%name, &
+        ''' keeps moving under the load (', travel, ' m in pseudo-time steps, the damping &
+        &still carrying ', fs, ' of the scene force); is every body held against every &
+        &load, by restraints or contacts?'
+      call fatal_error(err, trim(msg))
+    else
+      if (.not. allocated(err)) call fatal_error(err, 'the bodies did not settle')
+      err%message = 'stabilised: '//err%message
+    end if
+    rep%iters = iters
+    q = q_entry
+    if (present(contact)) then
+      contact%nact = size(act_entry); contact%act(1:size(act_entry)) = act_entry
+    end if
+  contains
+    !> From the stabilised state, Newton without the stabilising force: the equilibrium
+    !> exactly, where it is regular. Where it is not (frictionless bodies free to slide
+    !> sideways under no sideways load) the stabilised state stands: its force is within
+    !> Newton's tolerance.
+    subroutine unstabilised(iters)
+      integer, intent(inout) :: iters
+      type(newton_report_t) :: plain
+      type(error_t), allocatable :: err_plain
+      call newton_solve(model, asm, ls, q, fext, fresh, plain, err_plain, contact=contact, &
+                        load_factor=factor)
+      iters = iters + plain%iters
+      if (.not. allocated(err_plain) .and. plain%converged) rep = plain
+    end subroutine unstabilised
+  end subroutine stabilised_solve
+
+  !> The first stage's c [1/s^2]: (E / rho) / L^2 for the stiffest material, so that c M is
+  !> about the stiffness of a membrane the scene's size: the first pseudo-step moves a body
+  !> about as far as the load would stretch it
+  real(dp) function stabilisation(model)
+    type(model_t), intent(in) :: model
+    integer :: b
+    stabilisation = 0
+    do b = 1, model%nbody
+      stabilisation = max(stabilisation, model%body(b)%young/model%body(b)%density)
+    end do
+    stabilisation = stabilisation/model%length**2
+  end function stabilisation
+
+  !> The largest entry fs of the stabilising force c M (q - q_n) on the free parameters, and
+  !> the body it is on
+  subroutine stabilising_force(model, asm, q, q_n, c, fs, body)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    real(dp), intent(in) :: q(:), q_n(:), c
+    real(dp), intent(out) :: fs
+    integer, intent(out) :: body
+    real(dp), allocatable :: r0(:), r1(:)
+    real(dp) :: e
+    integer :: i
+    allocate (r0(size(q)), r1(size(q)))
+    call assemble(model, asm, q, .false., r1, e, c, c*q_n)
+    call assemble(model, asm, q, .false., r0, e)
+    r1 = abs(r1 - r0)
+    where (model%fixed) r1 = 0
+    i = maxloc(r1, 1)
+    fs = r1(i)
+    body = model%node_body((i - 1)/ndof_node + 1)
+  end subroutine stabilising_force
+end module casca_statics
