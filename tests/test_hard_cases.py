@@ -14,7 +14,12 @@ the landing and the step is cut; every step then ends on a multiple of its own l
 steps grow back onto the deck's grid and the frames land on their times (1e-6 of the step;
 casca before 2026-11-26 grew back off the grid and wrote its frames 25 us late for the rest
 of the run), and the energy balance's remainder (E0 less K + S - W and the friction work)
-ends at least -1e-3 E0: the run does not make energy."""
+ends at least -1e-3 E0: the run does not make energy. Plates: an aluminium plate (0.2 m
+square, h 2 mm) dropped flat at 5 m/s onto a clamped steel plate (a scene written from the
+README), generalized-alpha 0.8 and 0 at 20 us, 2 ms: its 169 nodes touch in one step and
+are released together in the next; the total energy never rises in a step by more than
+1e-6 E0 (casca before 2026-11-26 made 3.9% and 2.9% in the release step, whatever dt: the
+start acceleration kept part of the released contacts' force)."""
 import os
 import sys
 
@@ -199,4 +204,27 @@ if p.returncode == 0:
           np.abs(n - np.round(n)).max(), 1e-6)
     rest = h["total"][0] - h["total"] - h["friction_work"]
     ck.le("bowl: energy made over the run (- balance remainder at the end) / E0", -rest[-1] / h["total"][0], 1e-3)
+# a flat plate landing on a clamped plate: its 169 nodes touch in one step and leave in the
+# next, together; with generalized-alpha the release must not make energy
+for rho in ("0.8", "0.0"):
+    name = "plates_rho" + rho
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(f"""&run dt = 2.0e-5, t_end = 2.0e-3, rho_inf = {rho} /
+&output interval = 1.0e-4, vtu = .false., plots = .false. /
+&body name = 'top', mesh = 'plate', lx = 0.2, ly = 0.2, nx = 4, ny = 4, center = -0.1, -0.1, 0.012,
+  velocity = 0, 0, -5, young = 7e10, poisson = 0.33, density = 2700, thickness = 0.002 /
+&body name = 'base', mesh = 'plate', lx = 0.3, ly = 0.3, nx = 6, ny = 6, center = -0.15, -0.15, 0.0,
+  young = 2.1e11, poisson = 0.3, density = 7800, thickness = 0.004 /
+&restraint body = 'base', box_max = -0.149, 1e9, 1e9, fix = 'clamped' /
+&restraint body = 'base', box_min = 0.149, -1e9, -1e9, fix = 'clamped' /
+""")
+    out = os.path.join(work, name)
+    p = run([casca, "run", deck, "--out", out, "-q"])
+    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
+    if p.returncode == 0:
+        h = history(out)
+        ck.record("%s: the plates touch at many nodes at once" % name, h["contacts"].max() >= 100)
+        ck.le("%s: largest rise of the total energy in a step / E0" % name,
+              np.diff(h["total"]).max() / h["total"][0], 1e-6)
 ck.finish()

@@ -266,14 +266,15 @@ contains
     end do
   end subroutine row_list
 
-  !> y = y + M^-1 C^T (lambda - mu) over the constraints cons, every row: takes the forces
-  !> they carried out of an acceleration
-  subroutine add_impulses(ms, cons, model, y, err)
+  !> y = y + M^-1 C^T (share lambda - mu) over the constraints cons, every row: takes the
+  !> forces they carried out of an acceleration
+  subroutine add_impulses(ms, cons, model, y, err, share)
     type(mass_solver_t), intent(inout) :: ms
     type(constraint_t), intent(in) :: cons(:)
     type(model_t), intent(in) :: model
     real(dp), intent(inout) :: y(:)
     type(error_t), allocatable, intent(out) :: err
+    real(dp), intent(in) :: share   !< of a multiplier in the end acceleration (1: Newmark)
     type(rows_t) :: rows
     type(matrix_t) :: x(3)
     real(dp), allocatable :: amount(:), dy(:, :)
@@ -285,9 +286,9 @@ contains
     allocate (amount(n))
     do r = 1, n
       if (rkind(r) == 0) then
-        amount(r) = cons(rk(r))%lambda - cons(rk(r))%mu
+        amount(r) = share*cons(rk(r))%lambda - cons(rk(r))%mu
       else
-        amount(r) = cons(rk(r))%lt(rkind(r)) - cons(rk(r))%mut(rkind(r))
+        amount(r) = share*cons(rk(r))%lt(rkind(r)) - cons(rk(r))%mut(rkind(r))
       end if
     end do
     call build_rows(cons, rk, rkind, model, rows)
