@@ -35,8 +35,15 @@ sphere    a closed steel sphere (R 1 m, h 5 mm, 80 elements) with no restraint a
           thin SVK sphere's, p = 2 S11(lambda) h / (lambda R), within 0.2% of the
           displacement, as the restrained sphere of test_pressure; its centre has not moved
           (the two nodes' radii agree within 1e-9 m).
-friction  statics model no friction: casca check warns of a deck that gives some (and not
-          of one that does not).
+stick     the free plate laid on the floor (gap 0) under 1e4 Pa and pushed sideways by
+          1500 N (nodal shares), friction 0.3 (mu N = 3000 N): the floor's friction force is
+          the push at every load step (1e-6, Newton's force tolerance) and the plate has not
+          slid: its tracked node moves less than F / (E h), the stretch such a push gives
+          (nodes where the load's share exceeds mu times their own normal force slip a little).
+          Statics had no friction before: the plate slid away.
+slide     the same pushed by 4500 N, over mu N: no equilibrium, exit 3 naming the plate.
+moving    a static deck whose obstacle has a velocity is warned that statics keep it where it
+          is (and a fixed one is not).
 unheld    the free plate pushed sideways as well as down (frictionless): no equilibrium.
           casca exits 3 with a message naming the body and the cause.
 """
@@ -180,15 +187,35 @@ if out:
           np.max(np.abs(r[0] - s) / (s - 1)), 2e-3)
     ck.le("sphere: the two tracked nodes' radii [m]", np.max(np.abs(r[0] - r[1])), 1e-9)
 
-# statics model no friction: a deck that gives some is warned, one that does not is not
-deck = os.path.join(work, "friction.nml")
+# Coulomb friction in statics: the free plate on the floor (gap 0) under 1e4 Pa, pushed
+# sideways by F (nodal), mu 0.3: mu N = 3000 N
+def pushed(name, force):
+    return plate(name, "", f"""&load body = 'plate', kind = 'pressure', pressure = -1e4 /
+&load body = 'plate', force = {force}, 0, 0 /""").replace(f"point = 0, 0, {-HP / 2 - 0.003}",
+                                                       f"point = 0, 0, {-HP / 2}") + "&contact friction = 0.3 /\n"
+
+
+out, _ = run_scene(casca, ck, work, "stick", pushed("stick", 1500.0))
+if out:
+    h = history(out)
+    ck.le("stick: the floor's friction force vs the sideways load F t, largest relative difference",
+          np.max(np.abs(h["ftangent_plate_floor"] / (1500.0 * h["t"]) - 1)), 1e-6)
+    ck.le("stick: the plate has not slid: tracked x, y within F / (E h), the push's stretch [m]",
+          max(np.abs(h["p1_x"] - 1 / 3).max(), np.abs(h["p1_y"] - 1 / 3).max()), 1500.0 / (2e11 * HP))
+deck = os.path.join(work, "slide.nml")
 with open(deck, "w") as f:
-    f.write(plate("friction", HELD, PRESS) + "&contact friction = 0.3 /\n")
+    f.write(pushed("slide", 4500.0))
+p = run([casca, "run", deck, "--out", os.path.join(work, "slide"), "-q"])
+ck.record("slide: F over mu N: exit 3, no equilibrium, naming the plate",
+          p.returncode == 3 and "no equilibrium: body 'plate' keeps moving" in p.stderr, p.stderr[-300:])
+deck = os.path.join(work, "moving.nml")
+with open(deck, "w") as f:
+    f.write(plate("moving", HELD, PRESS).replace("normal = 0, 0, 1 /", "normal = 0, 0, 1, velocity = 0, 0, 1 /"))
 p = run([casca, "check", deck])
-ck.record("friction: casca check warns that statics are frictionless",
-          p.returncode == 0 and "warning: statics model no friction" in p.stderr, p.stderr[-300:])
+ck.record("moving: casca check warns that statics keep the obstacles where they are",
+          p.returncode == 0 and "has a velocity, but in statics the obstacles stay" in p.stderr, p.stderr[-300:])
 p = run([casca, "check", os.path.join(work, "plate.nml")])
-ck.record("friction: no such warning without friction", p.returncode == 0 and "warning" not in p.stderr,
+ck.record("moving: no warning for a fixed obstacle", p.returncode == 0 and "warning" not in p.stderr,
           p.stderr[-300:])
 
 deck = os.path.join(work, "unheld.nml")

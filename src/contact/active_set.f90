@@ -100,6 +100,10 @@ contains
       type(constraint_t), intent(inout) :: cn
       if (friction_on(c, cn%pair)) cn%grip = stick
       call constraint_geometry(c, model, x, q, cn)
+      if (c%stick_at_touch .and. cn%grip == stick) then   ! (its slip so far is not stuck)
+        cn%u0 = cn%ut
+        call constraint_geometry(c, model, x, q, cn)
+      end if
       if (cn%gap < -c%tol) then
         call push(cn)
         added = added + 1

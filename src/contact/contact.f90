@@ -45,6 +45,7 @@ module casca_contact
     real(dp) :: gt(2) = 0       !< stick rows' gaps: relative tangential displacement in the step
     real(dp) :: s(3) = 0        !< slip direction of the node relative to the target, held
     real(dp) :: ut(3) = 0       !< relative tangential displacement in the step
+    real(dp) :: u0(3) = 0       !< (stick_at_touch) its part before the contact was made
     !> the friction force on the node at the step's start (the last step's end), for its work
     real(dp) :: fa(3) = 0
     integer :: flips = 0        !< stick/slip changes in this step
@@ -83,10 +84,13 @@ module casca_contact
     type(obstacle_t), allocatable :: obstacle(:)
     real(dp) :: time = 0                        !< obstacles are where they are at this time
     ! Coulomb friction per pair: dynamic and static coefficients; the step's start positions
-    ! and length (friction needs them: without them, as in statics, contact is frictionless)
+    ! and length (friction needs them: without them contact is frictionless)
     real(dp), allocatable :: mu_d(:), mu_s(:)
     real(dp), allocatable :: x_start(:, :), g_start(:, :)   !< positions and fibres
     real(dp) :: dt = 0
+    !> statics: a contact made in a load increment sticks where it touched, not where its node
+    !> was at the increment's start (a cantilever's tip slides a long way before it touches)
+    logical :: stick_at_touch = .false.
     real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
     real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
     ! per pair: the impulse on the impactor so far, as the integrator applied it, and the

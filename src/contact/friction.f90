@@ -91,14 +91,16 @@ contains
     end do
   end subroutine friction_step_done
 
-  !> Per pair: the magnitude of the resultant tangential (friction) force on its impactor
+  !> Per pair: the magnitude of the resultant tangential (friction) force on its impactor, as
+  !> it acted at the end of the last step (fa: friction_step_done has since turned the
+  !> sliding constraints' directions to their slip)
   pure function pair_tangential_force(c) result(ft)
     type(contact_t), intent(in) :: c
     real(dp) :: ft(c%npairs), f(3, c%npairs)
     integer :: k
     f = 0
     do k = 1, c%nact
-      f(:, c%act(k)%pair) = f(:, c%act(k)%pair) + friction_force(c, c%act(k))
+      f(:, c%act(k)%pair) = f(:, c%act(k)%pair) + c%act(k)%fa
     end do
     ft = norm2(f, dim=1)
   end function pair_tangential_force

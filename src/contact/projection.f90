@@ -195,6 +195,7 @@ contains
       else
         u = u - c%dt*c%obstacle(-bt)%velocity
       end if
+      u = u - con%u0
       con%ut = u - dot_product(u, con%n)*con%n
       con%gt = [dot_product(u, con%t(:, 1)), dot_product(u, con%t(:, 2))]
     end subroutine friction_geometry

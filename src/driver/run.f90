@@ -667,7 +667,7 @@ contains
       friction = .false.
       allocate (character(len=1) :: pair_names(0))
       if (allocated(r%contact)) then
-        friction = deck%run%analysis /= 'static' .and. (any(r%contact%mu_d > 0) .or. any(r%contact%mu_s > 0))
+        friction = any(r%contact%mu_d > 0) .or. any(r%contact%mu_s > 0)
         no = size(deck%obstacles)
         allocate (sides(no + 1 + model%nbody))   ! (sides -no .. nbody)
         do k = 1, no

@@ -168,21 +168,14 @@ contains
     call put_warnings(far, err)
   end subroutine starter_report
 
-  !> What statics leave out of a deck that gives it: friction (the stick/slip of a load
-  !> increment is not modelled: contacts are frictionless) and the obstacles' motion (they
-  !> stay where they are at t = 0)
+  !> What statics leave out of a deck that gives it: the obstacles' motion (they stay where
+  !> they are at t = 0)
   function static_warnings(deck) result(w)
     type(deck_t), intent(in) :: deck
     character(len=400), allocatable :: w(:)
     integer :: k
     allocate (w(0))
     if (deck%run%analysis /= 'static') return
-    if (deck%contact%friction > 0 .or. any(deck%contact%pair_friction > 0) .or. &
-        (deck%contact%static_friction /= unset .and. deck%contact%static_friction > 0) .or. &
-        any(deck%contact%pair_static_friction /= unset .and. deck%contact%pair_static_friction > 0) .or. &
-        any(deck%obstacles%friction /= unset .and. deck%obstacles%friction > 0)) &
-      w = [character(len=400) :: w, 'statics model no friction: the contacts are frictionless '// &
-           '(friction acts in dynamic runs); hold the bodies sideways by restraints']
     do k = 1, size(deck%obstacles)
       if (any(deck%obstacles(k)%velocity /= 0)) w = [character(len=400) :: w, 'obstacle '''// &
         trim(deck%obstacles(k)%name)//''' has a velocity, but in statics the obstacles stay '// &

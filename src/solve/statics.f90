@@ -23,6 +23,9 @@ module casca_statics
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_contact, only: contact_t, constraint_t
+  use casca_contact_projection, only: positions
+  use casca_contact_friction, only: friction_step_done
+  use casca_time_scheme, only: newmark_scheme
   implicit none
   private
   public :: static_solve
@@ -55,9 +58,17 @@ contains
     integer :: level, iters
     logical :: unheld
     character(len=120) :: msg
+    type(constraint_t), allocatable :: before(:)
     at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
+      if (present(contact)) then   ! (friction's slip is over the load increment)
+        contact%stick_at_touch = .true.
+        contact%act(1:contact%nact)%u0(1) = 0; contact%act(1:contact%nact)%u0(2) = 0
+        contact%act(1:contact%nact)%u0(3) = 0
+        before = contact%act(1:contact%nact)
+        contact%x_start = positions(model, q); contact%g_start = positions(model, q, fibres=.true.)
+      end if
       call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
                         load_factor=at + step)   ! the pressures scaled too (issue 17)
       if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
@@ -80,6 +91,7 @@ contains
         deallocate (err)
         cycle
       end if
+      if (present(contact)) call friction_step_done(contact, newmark_scheme(0._dp, 1._dp), before)
       at = at + step
       if (level > 0 .and. rep%iters <= 4) level = level - 1   ! Newton is at ease: grow back
     end do
