@@ -153,8 +153,7 @@ contains
       end if
       if (gap_open()) cycle
       rep%converged = .true.
-      rep%residual = residual_estimate()/max(fref, tiny(1._dp))
-      rep%force_scale = fref
+      rep%residual = residual_estimate()/max(fref, tiny(1._dp)); rep%force_scale = fref
       rep%neg_pivots = negative_pivots(ls, asm, nc)
       return
     end do
