@@ -12,8 +12,8 @@
 !> a last Newton solve without it gives the equilibrium exactly where the equilibrium is
 !> regular, and where it is not (a frictionless body free to slide under no sideways load)
 !> the stabilised state stands, in equilibrium within the tolerance. A body that nothing holds
-!> against its load never stops (the damping goes on carrying a part of the load), and is an
-!> error naming it.
+!> against its load never stops (the damping goes on carrying a part of the load, and the
+!> body goes further than the scene's size), and is an error naming it.
 module casca_statics
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -147,15 +147,16 @@ contains
       fs = fs/rep%force_scale
       q_n = q; c = max(c/stage_factor, 2*c_fail)
     end do
-    ! (stages converged, and the damping still carries a part of the scene's force: it holds
-    ! what nothing else does; a body settling slowly leaves it a vanishing part)
-    if (moving > 0 .and. fs > unheld_part) then
+    ! (stages converged, the damping still carries a part of the scene's force, and a body
+    ! went further than the scene's size: it holds what nothing else does; a body settling
+    ! slowly, or snapping through, leaves it a vanishing part or stays within the scene)
+    travel = 0
+    do k = 1, 3   ! (the mid-surface's positions)
+      travel = max(travel, maxval(abs(q(k::ndof_node) - q_entry(k::ndof_node))))
+    end do
+    if (moving > 0 .and. fs > unheld_part .and. travel > model%length) then
       if (allocated(err)) deallocate (err)
       unheld = .true.
-      travel = 0
-      do k = 1, 3   ! (the mid-surface's positions)
-        travel = max(travel, maxval(abs(q(k::ndof_node) - q_entry(k::ndof_node))))
-      end do
       write (msg, '(3a,es9.2,a,es9.2,a)') 'no equilibrium: body ''', model%body(moving)%name, &
         ''' keeps moving under the load (', travel, ' m in pseudo-time steps, the damping &
         &still carrying ', fs, ' of the scene force); is every body held against every &
