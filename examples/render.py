@@ -8,7 +8,8 @@ the same camera and colour range, so that they compare: the camera looks along t
 side of the box holding all bodies in all the chosen frames (down the axis of the rings; when
 no side is under half the longest, as for a ball, along y with z up),
 with the box's longest side across the picture, and shows the whole box; the colours run
-from 0 to the highest speed in those frames."""
+from 0 to the highest speed in those frames. A static run's frames (no velocities; t is the
+load factor) are coloured by the displacement's magnitude and labelled with the load factor."""
 import math
 import os
 import sys
@@ -27,16 +28,16 @@ def nearest_frames(reader, times):
     return [min(available, key=lambda a: abs(a - t)) for t in times]
 
 
-def bounds_and_top_speed(speed, frames):
+def bounds_and_top(shade, frames):
     """The box (xmin, xmax, ymin, ymax, zmin, zmax) holding the bodies in all frames, and the
-    highest speed in them."""
+    highest value of the colour's field in them."""
     box = [math.inf, -math.inf] * 3
     top = 0.0
     for tt in frames:
-        UpdatePipeline(tt, speed)
-        b = speed.GetDataInformation().GetBounds()
+        UpdatePipeline(tt, shade)
+        b = shade.GetDataInformation().GetBounds()
         box = [min(box[i], b[i]) if i % 2 == 0 else max(box[i], b[i]) for i in range(6)]
-        top = max(top, speed.PointData["speed"].GetRange()[1])
+        top = max(top, shade.PointData["shade"].GetRange()[1])
     return box, top
 
 
@@ -63,22 +64,29 @@ def place_camera(view, box):
 folder = sys.argv[1]
 times = [float(t) for t in sys.argv[2:]] or [0.0]
 reader = PVDReader(FileName=os.path.join(folder, "run.pvd"))
-speed = Calculator(Input=reader, ResultArrayName="speed", Function="mag(velocity)")
+shade = Calculator(Input=reader, ResultArrayName="shade", Function="mag(velocity)")
+frames = nearest_frames(reader, times)
+box, top = bounds_and_top(shade, frames)
+static = top == 0 and max(frames) > 0   # (no velocity after the start: statics)
+if static:
+    shade.Function = "mag(displacement)"
+    box, top = bounds_and_top(shade, frames)
+what = "displacement [m]" if static else "speed [m/s]"
 view = GetActiveViewOrCreate("RenderView")
 view.ViewSize = [WIDTH, HEIGHT]
 view.UseColorPaletteForBackground = 0
 view.Background = [1, 1, 1]
 view.OrientationAxesVisibility = 1
-display = Show(speed, view)
-ColorBy(display, ("POINTS", "speed"))
+display = Show(shade, view)
+ColorBy(display, ("POINTS", "shade"))
 # mostly ambient light: a face seen edge-on keeps a colour that reads on the bar
 display.Ambient, display.Diffuse = 0.7, 0.3
-lut = GetColorTransferFunction("speed")
+lut = GetColorTransferFunction("shade")
 lut.ApplyPreset("Viridis (matplotlib)", True)
 lut.AutomaticRescaleRangeMode = "Never"   # keep the range below in every picture
 display.SetScalarBarVisibility(view, True)
 bar = GetScalarBar(lut, view)
-bar.Title = "speed [m/s]"
+bar.Title = what
 bar.ComponentTitle = ""
 bar.TitleColor = [0, 0, 0]   # the default white is lost on the white background
 bar.LabelColor = [0, 0, 0]
@@ -86,15 +94,14 @@ label = Text()
 label_display = Show(label, view)
 label_display.Color = [0, 0, 0]
 
-frames = nearest_frames(reader, times)
-box, top = bounds_and_top_speed(speed, frames)
 Render(view)   # the view's first render resets the camera: place it after that one
 place_camera(view, box)
 lut.RescaleTransferFunction(0.0, top if top > 0 else 1.0)
 for tt in frames:
     view.ViewTime = tt
-    UpdatePipeline(tt, speed)
-    label.Text = "t = %.2f ms   (colour: speed [m/s])" % (1e3 * tt)
+    UpdatePipeline(tt, shade)
+    when = "load factor %.3f" % tt if static else "t = %.2f ms" % (1e3 * tt)
+    label.Text = "%s   (colour: %s)" % (when, what)
     Render(view)
     out = os.path.join(folder, "frame_t%.6g.png" % tt)
     SaveScreenshot(out, view, ImageResolution=[WIDTH, HEIGHT])
