@@ -45,7 +45,9 @@ slide     the same pushed by 4500 N, over mu N: no equilibrium, exit 3 naming th
 moving    a static deck whose obstacle has a velocity is warned that statics keep it where it
           is (and a fixed one is not).
 unheld    the free plate pushed sideways as well as down (frictionless): no equilibrium.
-          casca exits 3 with a message naming the body and the cause.
+          casca exits 3 with a message naming the body and the cause. A restart from the
+          checkpoint it leaves (load step 0) is taken and meets the same cause (casca refused
+          it before: "history.dat ends at step -1, before the checkpoint's step 0").
 """
 import os
 import subprocess
@@ -225,4 +227,11 @@ p = run([casca, "run", deck, "--out", os.path.join(work, "unheld"), "-q"])
 ck.record("unheld: exit 3 naming the body and the cause",
           p.returncode == 3 and "no equilibrium: body 'plate' keeps moving" in p.stderr
           and "is every body held against every load" in p.stderr, "exit %d: %s" % (p.returncode, p.stderr[-400:]))
+# its checkpoint is of load step 0 (statics write no row for the unloaded state): a restart
+# from it is taken and meets the same cause, not refused as another run's history
+p = run([casca, "run", deck, "--out", os.path.join(work, "unheld"), "--restart",
+         os.path.join(work, "unheld", "checkpoint.h5"), "-q"])
+ck.record("unheld: a restart from its step-0 checkpoint runs and meets the same cause (exit 3)",
+          p.returncode == 3 and "no equilibrium: body 'plate' keeps moving" in p.stderr,
+          "exit %d: %s" % (p.returncode, p.stderr[-300:]))
 ck.finish()
