@@ -614,9 +614,8 @@ contains
     call scene_contact(r%deck, r%model, r%contact, use_contact)
     if (.not. use_contact) deallocate (r%contact)
     ! (statics: a body held by its contacts alone leaves K singular, not the saddle matrix)
-    r%ls%schur = .not. use_contact .or. r%deck%contact%solver == 'schur' .or. &
-                 (r%deck%contact%solver == 'auto' .and. r%deck%run%analysis /= 'static')
     r%ls%auto = use_contact .and. r%deck%contact%solver == 'auto' .and. r%deck%run%analysis /= 'static'
+    r%ls%schur = .not. use_contact .or. r%deck%contact%solver == 'schur' .or. r%ls%auto
     if (use_contact .and. r%deck%run%analysis /= 'static') call mass_setup(r%model, r%ls%mass, r%err)
   end subroutine setup_contact
 

@@ -17,9 +17,10 @@
 module casca_statics
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_model, only: model_t
+  use casca_model, only: model_t, element_dofs
+  use casca_mpi, only: sum_all
   use casca_shell_element, only: ndof_node
-  use casca_assembly, only: assembly_t, assemble
+  use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
   use casca_contact, only: contact_t, constraint_t
@@ -55,17 +56,18 @@ contains
     integer, intent(out) :: stabilised   !< increments that took the stabilised path
     type(contact_t), intent(inout), optional :: contact
     real(dp) :: at, step
-    integer :: level, iters
+    integer :: level, iters, k
     logical :: unheld, tried
     character(len=120) :: msg
     type(constraint_t), allocatable :: before(:)
     at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tried = .false.
+    if (present(contact)) contact%stick_at_touch = .true.
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
       if (present(contact)) then   ! (friction's slip is over the load increment)
-        contact%stick_at_touch = .true.
-        contact%act(1:contact%nact)%u0(1) = 0; contact%act(1:contact%nact)%u0(2) = 0
-        contact%act(1:contact%nact)%u0(3) = 0
+        do k = 1, contact%nact
+          contact%act(k)%u0 = 0
+        end do
         before = contact%act(1:contact%nact)
         contact%x_start = positions(model, q); contact%g_start = positions(model, q, fibres=.true.)
       end if
@@ -207,20 +209,28 @@ contains
   !> the body it is on
   subroutine stabilising_force(model, asm, q, q_n, c, fs, body)
     type(model_t), intent(in) :: model
-    type(assembly_t), intent(inout) :: asm
+    type(assembly_t), intent(in) :: asm
     real(dp), intent(in) :: q(:), q_n(:), c
     real(dp), intent(out) :: fs
     integer, intent(out) :: body
-    real(dp), allocatable :: r0(:), r1(:)
-    real(dp) :: e
-    integer :: i
-    allocate (r0(size(q)), r1(size(q)))
-    call assemble(model, asm, q, .false., r1, e, c, c*q_n)
-    call assemble(model, asm, q, .false., r0, e)
-    r1 = abs(r1 - r0)
-    where (model%fixed) r1 = 0
-    i = maxloc(r1, 1)
-    fs = r1(i)
+    real(dp), allocatable :: f(:)
+    real(dp) :: w(7, 10), v(3, 20)
+    integer :: d(7*10), i
+    allocate (f(size(q)))
+    f = 0
+    do i = 1, size(asm%owned)   ! (M on the vector parameters, as the inertia of casca_assembly)
+      d = element_dofs(model, asm%owned(i))
+      w = reshape(q(d) - q_n(d), [7, 10])
+      v(:, 1:10) = w(1:3, :); v(:, 11:20) = w(4:6, :)
+      v = c*matmul(v, model%emass(:, :, asm%owned(i)))
+      w = 0; w(1:3, :) = v(:, 1:10); w(4:6, :) = v(:, 11:20)
+      f(d) = f(d) + reshape(w, [7*10])
+    end do
+    call sum_all(f)
+    f = abs(f)
+    where (model%fixed) f = 0
+    i = maxloc(f, 1)
+    fs = f(i)
     body = model%node_body((i - 1)/ndof_node + 1)
   end subroutine stabilising_force
 end module casca_statics
