@@ -28,6 +28,11 @@ module casca_surface_search
     integer, allocatable :: tri(:, :)   !< (3, ntri) global node numbers of each sub-triangle
     integer, allocatable :: elem(:)     !< (ntri) parent element (global element number)
     integer, allocatable :: sub(:)      !< (ntri) 1..9: which sub-triangle of subtri10
+    !> (3, ntri) edge ab, bc, ca (the region_edge_* order) on the surface's rim: no other
+    !> sub-triangle shares it (an open surface's boundary)
+    logical, allocatable :: rim(:, :)
+    !> (3, ntri) vertex a, b, c on a rim edge
+    logical, allocatable :: rim_vertex(:, :)
   end type surface_t
 
   !> Bucket grid over the sub-triangles' bounding boxes at the positions of the last
@@ -78,7 +83,50 @@ contains
         surf%sub(it) = s
       end do
     end do
+    call find_rim(surf)
   end subroutine surface_init
+
+  !> The rim: the sub-triangle edges no other sub-triangle shares, found through each node's
+  !> sub-triangles (a handful), and the vertices on them.
+  subroutine find_rim(surf)
+    type(surface_t), intent(inout) :: surf
+    integer, allocatable :: start(:), list(:), fill(:)
+    logical, allocatable :: on_rim(:)
+    integer :: nn, it, k, a, b, j, shared
+    nn = maxval(surf%tri)
+    allocate (start(nn + 1), fill(nn), list(3*surf%ntri), on_rim(nn))
+    start = 0
+    do it = 1, surf%ntri
+      start(surf%tri(:, it) + 1) = start(surf%tri(:, it) + 1) + 1
+    end do
+    start(1) = 1
+    do k = 1, nn
+      start(k + 1) = start(k + 1) + start(k)
+    end do
+    fill = start(1:nn)
+    do it = 1, surf%ntri
+      do k = 1, 3
+        a = surf%tri(k, it)
+        list(fill(a)) = it; fill(a) = fill(a) + 1
+      end do
+    end do
+    allocate (surf%rim(3, surf%ntri), surf%rim_vertex(3, surf%ntri))
+    on_rim = .false.
+    do it = 1, surf%ntri
+      do k = 1, 3
+        a = surf%tri(k, it); b = surf%tri(mod(k, 3) + 1, it)
+        shared = 0
+        do j = start(a), start(a + 1) - 1
+          if (list(j) /= it .and. any(surf%tri(:, list(j)) == b)) shared = shared + 1
+        end do
+        surf%rim(k, it) = shared == 0
+        if (shared == 0) on_rim([a, b]) = .true.
+      end do
+    end do
+    do it = 1, surf%ntri
+      surf%rim_vertex(:, it) = on_rim(surf%tri(:, it))
+    end do
+  end subroutine find_rim
 
   !> (Re)bin the sub-triangles at the current coordinates x(3, nnode). O(ntri + cells); the
   !> arrays are reused when large enough, since this runs every Newton iteration. With
