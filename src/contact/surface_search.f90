@@ -16,6 +16,7 @@ module casca_surface_search
   use casca_kinds, only: dp
   use casca_shape_tri10, only: tri10_node_xi, subtri10
   use casca_closest_point, only: closest_point_triangle
+  use casca_orientation, only: vertex_elements
   implicit none
   private
   public :: surface_t, grid_t
@@ -86,41 +87,24 @@ contains
     call find_rim(surf)
   end subroutine surface_init
 
-  !> The rim: the sub-triangle edges no other sub-triangle shares, found through each node's
-  !> sub-triangles (a handful), and the vertices on them.
+  !> The rim: the sub-triangle edges no other sub-triangle shares, found through the
+  !> sub-triangles at each vertex (as casca_orientation's edge census), and the vertices on them.
   subroutine find_rim(surf)
     type(surface_t), intent(inout) :: surf
-    integer, allocatable :: start(:), list(:), fill(:)
+    integer, allocatable :: start(:), at(:)
     logical, allocatable :: on_rim(:)
-    integer :: nn, it, k, a, b, j, shared
-    nn = maxval(surf%tri)
-    allocate (start(nn + 1), fill(nn), list(3*surf%ntri), on_rim(nn))
-    start = 0
-    do it = 1, surf%ntri
-      start(surf%tri(:, it) + 1) = start(surf%tri(:, it) + 1) + 1
-    end do
-    start(1) = 1
-    do k = 1, nn
-      start(k + 1) = start(k + 1) + start(k)
-    end do
-    fill = start(1:nn)
-    do it = 1, surf%ntri
-      do k = 1, 3
-        a = surf%tri(k, it)
-        list(fill(a)) = it; fill(a) = fill(a) + 1
-      end do
-    end do
-    allocate (surf%rim(3, surf%ntri), surf%rim_vertex(3, surf%ntri))
+    integer :: it, k, a, b, j
+    call vertex_elements(surf%tri, maxval(surf%tri), start, at)
+    allocate (surf%rim(3, surf%ntri), surf%rim_vertex(3, surf%ntri), on_rim(maxval(surf%tri)))
     on_rim = .false.
     do it = 1, surf%ntri
       do k = 1, 3
         a = surf%tri(k, it); b = surf%tri(mod(k, 3) + 1, it)
-        shared = 0
+        surf%rim(k, it) = .true.
         do j = start(a), start(a + 1) - 1
-          if (list(j) /= it .and. any(surf%tri(:, list(j)) == b)) shared = shared + 1
+          if (at(j) /= it .and. any(surf%tri(:, at(j)) == b)) surf%rim(k, it) = .false.
         end do
-        surf%rim(k, it) = shared == 0
-        if (shared == 0) on_rim([a, b]) = .true.
+        if (surf%rim(k, it)) on_rim([a, b]) = .true.
       end do
     end do
     do it = 1, surf%ntri
