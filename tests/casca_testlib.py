@@ -120,3 +120,35 @@ def svk_sphere_stretch(p, young, nu, h, radius):
         m = (a + b) / 2
         a, b = (a, m) if excess(m) > 0 else (m, b)
     return (a + b) / 2
+
+
+def blade_case(casca, ck, work, name, angle, contact=""):
+    """A steel plate (0.2 x 0.1 m, 4 x 2 cells, h 2 mm) tilted angle degrees, its lower edge
+    3 mm above a clamped steel plate (0.4 m, 6 x 6 cells, h 2 mm) listed first, dropped
+    edge-first at 10 m/s (generalized-alpha 0.8, 10 us, 0.6 ms; contact: &contact's keys).
+    Records that they touch, that the energy never rises in a step by more than 1e-3 E0, and
+    that the blade's tracked edge node stays (h/2)(1 + cos angle) - 1e-4 m above the plate's
+    node below it (the plate's half thickness and the blade's lower face corner)."""
+    steel = "young = 210e9, poisson = 0.3, density = 7700, thickness = 0.002"
+    out, _ = run_scene(casca, ck, work, name, f"""&run dt = 1.0e-5, t_end = 6.0e-4, rho_inf = 0.8 /
+&output interval = 1.0e-4, vtu = .false., plots = .false.,
+  track = 0.0, 0.0, 0.003,   0.0, 0.0, 0.0, track_body = 'blade', 'base' /
+&body name = 'base', mesh = 'plate', lx = 0.4, ly = 0.4, nx = 6, ny = 6, center = -0.2, -0.2, 0,
+  {steel} /
+&body name = 'blade', mesh = 'plate', lx = 0.2, ly = 0.1, nx = 4, ny = 2,
+  rotate_axis = 1, 0, 0, rotate_angle = {angle}, center = -0.1, 0, 0.003, velocity = 0, 0, -10,
+  {steel} /
+&restraint body = 'base', box_min = -1, -1, -1, box_max = 1, -0.19, 1, fix = 'clamped' /
+&restraint body = 'base', box_min = -1, 0.19, -1, box_max = 1, 1, 1, fix = 'clamped' /
+&contact {contact} /
+""")
+    if out is None:
+        return
+    h = history(out)
+    ck.record("%s: the blade and the plate touch" % name, h["contacts"].max() > 0)
+    ck.le("%s: largest rise of the total energy in a step / E0" % name,
+          np.diff(h["total"]).max() / h["total"][0], 1e-3)
+    least = 0.001 * (1 + np.cos(np.radians(angle)))
+    ck.le("%s: the edge stays on the plate's face ((h/2)(1 + cos angle) - least height of the "
+          "edge node over the plate's node below it) [m]" % name,
+          least - (h["p1_z"] - h["p2_z"]).min(), 1e-4)

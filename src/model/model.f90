@@ -12,7 +12,7 @@ module casca_model
   implicit none
   private
   public :: body_t, model_t, model_add_body, model_finalize, dof, element_dofs, reference_state
-  public :: area_points, thick_points
+  public :: area_points, thick_points, element_area
 
   integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
   integer, parameter :: thick_points = 3
@@ -171,5 +171,17 @@ contains
       q(dof(i, 7)) = 0
     end do
   end subroutine reference_state
+
+  !> Area of element e's cubic mid-surface (the model's area rule)
+  pure real(dp) function element_area(model, e) result(a)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: e
+    integer :: ia
+    a = 0
+    do ia = 1, area_points
+      a = a + model%rule%wa(ia)* &
+          norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
+    end do
+  end function element_area
 
 end module casca_model

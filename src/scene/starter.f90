@@ -25,7 +25,7 @@ module casca_starter
   use casca_kinds, only: dp
   use casca_mesh, only: nen
   use casca_deck, only: deck_t, unset
-  use casca_model, only: model_t, dof, element_dofs, area_points
+  use casca_model, only: model_t, dof, element_dofs, area_points, element_area
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
   use casca_strings, only: itoa, rtoa, count_of
@@ -104,18 +104,6 @@ contains
     real(dp), intent(in) :: lam, mu, rho, h
     omega = 2*sqrt(3*(lam + 2*mu)/rho)/h
   end function thickness_frequency
-
-  !> Area of element e's cubic mid-surface (the model's area rule)
-  pure real(dp) function element_area(model, e) result(a)
-    type(model_t), intent(in) :: model
-    integer, intent(in) :: e
-    integer :: ia
-    a = 0
-    do ia = 1, area_points
-      a = a + model%rule%wa(ia)* &
-          norm2(tri10_normal(model%x0(:, model%conn(:, e)), model%rule%dphi(:, :, ia)))
-    end do
-  end function element_area
 
   !> Element e's min/max of the area Jacobian over the model's area points, signed by the
   !> element's normal at its centroid: below 0 the map folds over inside the element
