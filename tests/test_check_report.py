@@ -22,6 +22,10 @@ obstacles      a ring (R 0.2, h 0.04) at (1, -2, 0) m/s above a floor plane 0.3 
                it), closing speed 3 c m/s, time gap / (3 c); the same sphere at rest: 'never'
                (the ring moves away from it).
 self-contact   the ring's pair with itself: time to contact 'never' (its rigid motion closes no gap).
+denser target  a thin tube (R 40 mm, width 120 mm, 16 x 3 cells) listed as the target of a plate
+               (0.3 m, 8 x 8 cells): the warning gives the plate's area per node over the tube's,
+               (0.3^2 / 25^2) / (2 pi R w / (48 x 10)) = 2.29, within 1%; listed the other way
+               round, or with passes = 2, no such warning.
 """
 import math
 import os
@@ -118,4 +122,32 @@ got = check("sphere_at_rest", ring_obstacles(0.0))
 ball = got.get(("ring", "ball"), (None,) * 3)
 ck.record("sphere at rest above a ring moving down: 'never'", ("ring", "ball") in got and ball[2] is None
           and ball[1] is not None and ball[1] < 0, str(ball))
+# a thin tube (R 40 mm, 120 mm, 16 x 3 cells) listed as the target of a coarse plate (0.3 m,
+# 8 x 8 cells): the tube's area per node, 2 pi R w / (3*16 (3*3 + 1)), is the plate's
+# 0.3^2 / 25^2 over 2.29; with one pass the warning names that ratio, listed the other way
+# round or with passes = 2 there is none
+Rt, wt = 0.04, 0.12
+ratio = (0.3**2 / 25**2) / (2 * math.pi * Rt * wt / (48 * 10))
+for name, contact, warned in (("coarse_impactor", "pairs = 'plate', 'tube'", True),
+                              ("fine_impactor", "pairs = 'tube', 'plate'", False),
+                              ("two_passes", "pairs = 'plate', 'tube', passes = 2", False)):
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(f"""&run dt = 1.0e-5, t_end = 2.0e-3 /
+&body name = 'plate', mesh = 'plate', lx = 0.3, ly = 0.3, nx = 8, ny = 8, center = -0.15, -0.15, 0,
+  young = 70e9, poisson = 0.33, density = 2700, thickness = 0.003 /
+&body name = 'tube', mesh = 'ring', radius = {Rt}, width = {wt}, n_around = 16, n_across = 3,
+  rotate_axis = 1, 0, 0, rotate_angle = 90, center = 0, 0, 0.0435, velocity = 0, 0, -15,
+  young = 210e9, poisson = 0.3, density = 7800, thickness = 0.001 /
+&contact {contact} /
+""")
+    p = run([casca, "check", deck])
+    m = re.search(r"the target's nodes are (\S+) times denser", p.stderr)
+    if warned:
+        ck.record("%s: warned that the target's nodes are denser" % name, m is not None, p.stderr[-300:])
+        if m:
+            ck.close("%s: the ratio of the areas per node" % name, float(m.group(1)), ratio, 0.01)
+    else:
+        ck.record("%s: no warning of denser target nodes" % name, m is None and p.returncode == 0,
+                  p.stderr[-300:])
 ck.finish()

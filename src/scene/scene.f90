@@ -20,7 +20,11 @@ module casca_scene
   implicit none
   private
   public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles, &
-            scene_contact
+            scene_contact, area_per_node, clearly
+
+  !> One body's nodes are clearly denser than another's when its area per node is this many
+  !> times smaller (impacts_first)
+  real(dp), parameter :: clearly = 1.2_dp
 
 contains
 
@@ -191,7 +195,7 @@ contains
     else
       do i = 1, model%nbody
         do j = i + 1, model%nbody
-          if (deck%contact%surface == 'faces' .and. impacts_first(j, i)) then
+          if (deck%contact%surface == 'faces' .and. impacts_first(model, j, i)) then
             call add(j, i)
           else
             call add(i, j)
@@ -228,44 +232,47 @@ contains
       pairs = reshape([pairs, a, b], [2, size(pairs, 2) + 1])
     end subroutine add
 
-    !> With one pass only the impactor's nodes are tested, so a target's nodes can pass
-    !> between them: as the codes advise for a slave surface, the body whose nodes are
-    !> clearly denser (area per node 1.2 times smaller) impacts, else the clearly smaller
-    !> one (its rim meets the other's face), else the earlier in the deck. Between faces
-    !> only: 'mid' contact is one-sided on the target's normal side, which the deck's order
-    !> chooses
-    logical function impacts_first(a, b)
-      integer, intent(in) :: a, b
-      real(dp), parameter :: clearly = 1.2_dp
-      real(dp) :: area(2), per_node(2)
-      area = [body_area(a), body_area(b)]
-      per_node = area/[nodes_of(a), nodes_of(b)]
-      if (per_node(1)*clearly < per_node(2) .or. per_node(2)*clearly < per_node(1)) then
-        impacts_first = per_node(1) < per_node(2)
-      else
-        impacts_first = area(1)*clearly < area(2)
-      end if
-    end function impacts_first
-
-    real(dp) function body_area(b)
-      integer, intent(in) :: b
-      integer :: e
-      body_area = 0
-      do e = model%body(b)%elem_first, model%body(b)%elem_last
-        body_area = body_area + element_area(model, e)
-      end do
-    end function body_area
-
-    integer function nodes_of(b)
-      integer, intent(in) :: b
-      nodes_of = model%body(b)%node_last - model%body(b)%node_first + 1
-    end function nodes_of
-
     integer function body_index(name)
       character(len=*), intent(in) :: name
       body_index = findloc([(model%body(i)%name == name, i=1, model%nbody)], .true., dim=1)
     end function body_index
   end function contact_pairs
+
+  !> With one pass only the impactor's nodes are tested, so a target's nodes can pass
+  !> between them: as the codes advise for a slave surface, the body whose nodes are
+  !> clearly denser (area per node `clearly` times smaller) impacts, else the clearly smaller
+  !> one (its rim meets the other's face), else the earlier in the deck. Between faces
+  !> only: 'mid' contact is one-sided on the target's normal side, which the deck's order
+  !> chooses
+  logical function impacts_first(model, a, b)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: a, b
+    real(dp) :: per_node(2)
+    per_node = [area_per_node(model, a), area_per_node(model, b)]
+    if (per_node(1)*clearly < per_node(2) .or. per_node(2)*clearly < per_node(1)) then
+      impacts_first = per_node(1) < per_node(2)
+    else
+      impacts_first = per_node(1)*nodes_of(model, a)*clearly < per_node(2)*nodes_of(model, b)
+    end if
+  end function impacts_first
+
+  !> Body b's mid-surface area over its number of nodes [m^2]
+  real(dp) function area_per_node(model, b)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    integer :: e
+    area_per_node = 0
+    do e = model%body(b)%elem_first, model%body(b)%elem_last
+      area_per_node = area_per_node + element_area(model, e)
+    end do
+    area_per_node = area_per_node/nodes_of(model, b)
+  end function area_per_node
+
+  integer function nodes_of(model, b)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    nodes_of = model%body(b)%node_last - model%body(b)%node_first + 1
+  end function nodes_of
 
   !> The contact problem of the deck (contact_pairs), or none: its pairs and obstacles,
   !> tolerance, surfaces and normals, and each pair's coefficients of friction (its

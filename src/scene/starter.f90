@@ -29,7 +29,7 @@ module casca_starter
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
   use casca_strings, only: itoa, rtoa, count_of
-  use casca_scene, only: scene_contact, initial_state, tracked_nodes
+  use casca_scene, only: scene_contact, initial_state, tracked_nodes, area_per_node, clearly
   use casca_newmark, only: state_t
   use casca_contact, only: contact_t, search_radius
   use casca_pair_gaps, only: pair_gap_t, pair_gaps_at
@@ -319,9 +319,10 @@ contains
   end function body_warnings
 
   !> Pairs that never meet at the initial velocities while nothing else can set them moving
-  !> (gravity, a load, a pair with a third body that closes), and pairs whose closing speed
+  !> (gravity, a load, a pair with a third body that closes), pairs whose closing speed
   !> carries a node across the target's contact band (search_radius: what a step can still
-  !> detect) in one step. Dynamic runs only (statics has no speeds).
+  !> detect) in one step, and pairs between faces tested one way only whose target's nodes
+  !> are clearly denser than the impactor's. Dynamic runs only (statics has no speeds).
   function pair_warnings(deck, model) result(w)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
@@ -331,7 +332,7 @@ contains
     type(pair_gap_t), allocatable :: pg(:)
     character(len=:), allocatable :: label
     logical :: pushed(model%nbody)   ! by gravity, a load or a closing pair
-    real(dp) :: band
+    real(dp) :: band, ratio
     integer :: p, bi, bt
     logical :: found
     allocate (w(0))
@@ -373,6 +374,14 @@ contains
           rtoa(pg(p)%speed)//' m/s), more than the '//rtoa(band)//' m band in which contact '// &
           'finds a node: a node can cross the target unseen; dt below '// &
           rtoa(band/pg(p)%speed)//' s keeps it in')
+      end if
+      if (bt > 0 .and. deck%contact%surface == 'faces') then
+        ratio = area_per_node(model, bi)/area_per_node(model, bt)
+        if (ratio > clearly .and. .not. any(c%pair(1, :) == bt .and. c%pair(2, :) == bi)) &
+          call add(w, label//': the target''s nodes are '//rtoa(ratio)//' times denser '// &
+                   '(area per node) than the impactor''s, and only the impactor''s are held off '// &
+                   'the other surface: the target''s may pass between them; list the pair '// &
+                   'the other way round, or passes = 2')
       end if
     end do
   end function pair_warnings
