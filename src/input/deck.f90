@@ -484,6 +484,9 @@ contains
         '&run: give either rho_inf (generalized-alpha) or beta and gamma (Newmark), not both')
       if (beta /= unset) c%beta = beta
       if (gamma /= unset) c%gamma = gamma
+      ! an error asked for and no scheme named: a second-order one, whose local error falls as
+      ! dt^3 where the thesis' Newmark's falls as dt^2 (and which keeps the energy)
+      if (tolerance /= unset .and. all([rho_inf, beta, gamma] == unset)) c%rho_inf = 0.8_dp
       c%newton_tol = newton_tol; c%newton_max_iter = newton_max_iter
       c%load_steps = load_steps; c%max_step_cuts = max_step_cuts; c%gravity = gravity
       c%reuse_factorisation = reuse_factorisation
