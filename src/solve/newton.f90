@@ -99,6 +99,7 @@ contains
     type(rows_t) :: rows
     type(increment_t) :: inc
     integer :: it, it_set, nc, version
+    integer :: set_start   !< the first increment of the current active set
     real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
     logical :: fresh, refresh_next
 
@@ -115,7 +116,7 @@ contains
     ffloor = 0
     if (present(cm)) ffloor = inertial_floor(model, cm, opts%tol)
     refresh_next = .false.
-    it_set = 0
+    it_set = 0; set_start = 1
     do it = 1, max_hist
       it_set = it_set + 1
       if (it_set > opts%max_iter) exit
@@ -149,6 +150,7 @@ contains
       if (set_changed()) then
         if (allocated(err)) exit
         it_set = 0   ! (each set has its own max_iter; at most max_set_changes sets)
+        set_start = rep%nincr + 1
         cycle
       end if
       if (gap_open()) cycle
@@ -210,11 +212,11 @@ contains
     !> a new matrix unless the kept one still contracts the increment fast enough (decided
     !> from replicated figures, so alike on every rank). With constraints, slow contraction
     !> comes first from the rows (their normal is held): Z is renewed first, K only if
-    !> contraction stays poor.
+    !> contraction stays poor. Increments of two active sets say nothing of the factors.
     logical function refresh_needed()
       refresh_needed = refresh_next .or. .not. (opts%reuse .and. ls%solver(1)%factored)
       refresh_next = .false.
-      if (refresh_needed .or. rep%nincr < 2) return
+      if (refresh_needed .or. rep%nincr < set_start + 1) return
       if (ls%schur .and. nc > 0) then
         if (rep%nincr >= 3) refresh_needed = contraction() > 0.5_dp
       else
@@ -277,7 +279,7 @@ contains
       real(dp), allocatable :: d(:)
       logical :: renew
       renew = .false.
-      if (rep%nincr >= 2) renew = contraction() > 0.25_dp
+      if (rep%nincr >= set_start + 1) renew = contraction() > 0.25_dp
       call solve_increment(model, asm, ls, rows, res, renew, d, err)
       if (allocated(err)) return
       inc%q = q; inc%dq = d(1:model%ndof); inc%dlambda = d(model%ndof + 1:)
