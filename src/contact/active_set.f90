@@ -118,14 +118,15 @@ contains
     logical function edge_on(cn)
       type(constraint_t), intent(in) :: cn
       type(constraint_t) :: cs
+      integer :: m
       edge_on = .false.
       if (.not. c%faces .or. cn%elem <= 0 .or. .not. allocated(c%x_start)) return
       if (c%dt <= 0) return
       if (.not. allocated(q_start)) then
         q_start = q
-        do k = 1, model%nnode
-          q_start(dof(k, 1):dof(k, 3)) = c%x_start(:, k)
-          q_start(dof(k, 4):dof(k, 6)) = c%g_start(:, k)
+        do m = 1, model%nnode
+          q_start(dof(m, 1):dof(m, 3)) = c%x_start(:, m)
+          q_start(dof(m, 4):dof(m, 6)) = c%g_start(:, m)
         end do
       end if
       cs = cn

@@ -16,7 +16,7 @@ module casca_contact
   implicit none
   private
   public :: contact_t, constraint_t, target_geometry_t, contact_init, face_reach, search_radius
-  public :: contact_set_stiffness, normal_compliance, normal_residual, holds
+  public :: contact_set_stiffness, normal_compliance, normal_residual, holds, tested_both_ways
 
   type :: constraint_t
     integer :: node = 0, pair = 0
@@ -253,6 +253,14 @@ contains
     if (bt > 0) face_reach = face_reach + 0.5_dp*model%body(bt)%thickness
     face_reach = 1.25_dp*face_reach
   end function face_reach
+
+  !> Whether bodies bi and bt are tested both ways round: (bi, bt) and (bt, bi) are pairs
+  pure logical function tested_both_ways(c, bi, bt)
+    type(contact_t), intent(in) :: c
+    integer, intent(in) :: bi, bt
+    tested_both_ways = any(c%pair(1, :) == bi .and. c%pair(2, :) == bt) .and. &
+                       any(c%pair(1, :) == bt .and. c%pair(2, :) == bi)
+  end function tested_both_ways
 
   !> How far from the target's mid-surface a node of bi is looked for: the faces' reach and,
   !> for a body, the band below its surface; for an obstacle, the contact tolerance

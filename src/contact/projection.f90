@@ -22,7 +22,7 @@ module casca_contact_projection
   use casca_obstacle, only: obstacle_point
   use casca_closest_point, only: region_face, region_edge_ab, region_edge_bc, region_edge_ca, &
                                  region_vertex_a, region_vertex_b, region_vertex_c
-  use casca_contact, only: contact_t, constraint_t, search_radius
+  use casca_contact, only: contact_t, constraint_t, search_radius, tested_both_ways
   implicit none
   private
   public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face, &
@@ -105,7 +105,7 @@ contains
           return
         end if
         if (bi /= bt .and. on_rim(g%surf(bt), itri, region)) then
-          if (any(c%pair(1, :) == bt .and. c%pair(2, :) == bi)) then
+          if (tested_both_ways(c, bi, bt)) then
             ok = .false.
             return
           end if

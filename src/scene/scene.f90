@@ -178,9 +178,9 @@ contains
   end subroutine build_model
 
   !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),
-  !> or every pair of bodies, the one impacting chosen by impacts_first ('faces'); with passes = 2 each body pair
-  !> also the other way round; then each obstacle's bodies against it (target -k: obstacle k).
-  !> None when contact is off.
+  !> or every pair of bodies, the impactor chosen by impacts_first ('faces'); with passes = 2
+  !> each body pair also the other way round; then each obstacle's bodies against it (target
+  !> -k: obstacle k). None when contact is off.
   function contact_pairs(deck, model) result(pairs)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model

@@ -31,7 +31,7 @@ module casca_starter
   use casca_strings, only: itoa, rtoa, count_of
   use casca_scene, only: scene_contact, initial_state, tracked_nodes, area_per_node, clearly
   use casca_newmark, only: state_t
-  use casca_contact, only: contact_t, search_radius
+  use casca_contact, only: contact_t, search_radius, tested_both_ways
   use casca_pair_gaps, only: pair_gap_t, pair_gaps_at
   use casca_sanity, only: bytes_per_element
   implicit none
@@ -377,7 +377,7 @@ contains
       end if
       if (bt > 0 .and. deck%contact%surface == 'faces') then
         ratio = area_per_node(model, bi)/area_per_node(model, bt)
-        if (ratio > clearly .and. .not. any(c%pair(1, :) == bt .and. c%pair(2, :) == bi)) &
+        if (ratio > clearly .and. .not. tested_both_ways(c, bi, bt)) &
           call add(w, label//': the target''s nodes are '//rtoa(ratio)//' times denser '// &
                    '(area per node) than the impactor''s, and only the impactor''s are held off '// &
                    'the other surface: the target''s may pass between them; list the pair '// &
