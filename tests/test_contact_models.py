@@ -33,11 +33,14 @@ pusher     the same ring at rest, struck by a plane moving at V = 2 m/s: the mid
            with the thickness strain, below 1e-3 here) and after contact the ring moves at least
            at V (it cannot be overtaken by the plane that pushes it). The plane's work in the
            history (obstacle_work) equals V times the ring's momentum change, the plane's force
-           being the only force on it (1e-8 relative).
+           being the only force on it (1e-8 relative), and so does the printed energy
+           balance's 'taken from moving obstacles' (1e-4: printed to 5 digits; it was printed
+           with the opposite sign before 2026-11-26).
 bad input  unknown obstacle shape, a sphere without radius, contact surface 'top', passes 3:
            exit 2 naming the file, the group and the field.
 """
 import os
+import re
 import sys
 
 import numpy as np
@@ -158,12 +161,13 @@ if h is not None:
 
 # --- a moving plane
 V = 2.0
-h = go("pusher", f"""&run dt = {dt}, t_end = 1.5e-2 /
+out, stdout = run_scene(casca, ck, work, "pusher", f"""&run dt = {dt}, t_end = 1.5e-2 /
 &output vtu = .false., plots = .false., track = 0.0, -0.2, 0.0, track_body = 'ring' /
 &body name = 'ring', mesh = 'file', file = '{ring2}', {STEEL}, thickness = {hr} /
 &obstacle name = 'pusher', shape = 'plane', point = 0.0, -0.221, 0.0, normal = 0.0, 1.0, 0.0,
   velocity = 0.0, {V}, 0.0 /
-""")
+""", quiet=False)
+h = history(out) if out else None
 if h is not None:
     m = 7700 * hr * 0.05 * 2 * np.pi * 0.2
     gap = h["p1_y"] - hr / 2 - (-0.221 + V * h["t"])
@@ -173,6 +177,10 @@ if h is not None:
               "vy %.4g m/s" % (h["py"][-1] / m))
     ck.close("pusher: the plane's work [J] vs V times the ring's momentum change (its only force)",
              h["obstacle_work"][-1], V * (h["py"][-1] - h["py"][0]), 1e-8)
+    m = re.search(r"taken from moving obstacles ([-+.0-9Ee]+)", stdout)
+    ck.close("pusher: the energy balance's 'taken from moving obstacles' [J] vs V times the ring's "
+             "momentum change (the energy the plane gave)", float(m.group(1)) if m else float("nan"),
+             V * (h["py"][-1] - h["py"][0]), 1e-4)
 
 # --- bad input
 base = f"""&run dt = 1e-5, t_end = 1e-4 /

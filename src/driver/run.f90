@@ -904,7 +904,8 @@ contains
     if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
                                                              sum(contact%friction_work))]
     if (moving_obstacles(deck, .true.)) &
-      terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work)]
+      terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work, &
+                                                          source=.true.)]
     if (contact%compliant) terms = [terms, energy_term_t('held in the contact stiffness', &
                                                          contact_stored_energy(contact))]
   end function balance_terms

@@ -23,10 +23,12 @@ module casca_accounting
   end type balance_t
 
   !> A named share of the initial energy taken out of the bodies (positive: removed), for
-  !> energy_balance: friction, work done on obstacles, ...
+  !> energy_balance: friction, work done on obstacles, ... A source (the work of moving
+  !> obstacles) is printed as what it gave, -value, as the work of loads is
   type :: energy_term_t
     character(len=:), allocatable :: name
     real(dp) :: value = 0
+    logical :: source = .false.
   end type energy_term_t
 
 contains
@@ -164,7 +166,7 @@ contains
            rtoa(b%strain)//', work of loads '//rtoa(b%work)
     if (present(extra)) then
       do k = 1, size(extra)
-        line = line//', '//extra(k)%name//' '//rtoa(extra(k)%value)
+        line = line//', '//extra(k)%name//' '//rtoa(merge(-1, 1, extra(k)%source)*extra(k)%value)
       end do
     end if
     line = line//', removed by the time integrator and contact '//rtoa(rest)
