@@ -184,14 +184,23 @@ contains
   !> Where Newton has converged for the set: stick/slip changes first, else releases and new
   !> penetrations (which also measures the gaps at q). A trial stick's multiplier may be
   !> tensile only because it stopped the sliding: released first, the node would be taken
-  !> again, step after step. changed: how many changes.
-  subroutine contact_settle(c, model, q, changed)
+  !> again, step after step. changed: how many changes. With stick = .false. (an iterate
+  !> near convergence, not converged) stick and slip are left for later: Coulomb's law has
+  !> more than one consistent state, and a hoop rolling from node to node, whose stick or
+  !> slip was decided early, made four times the energy in a step.
+  subroutine contact_settle(c, model, q, changed, stick)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     integer, intent(out) :: changed
+    logical, intent(in), optional :: stick
     integer :: released, added
-    call friction_update(c, changed)
+    changed = 0
+    if (.not. present(stick)) then
+      call friction_update(c, changed)
+    else if (stick) then
+      call friction_update(c, changed)
+    end if
     if (changed > 0) return
     call contact_release(c, released)
     call contact_update(c, model, q, .true., added, reproject=.false.)
