@@ -152,7 +152,7 @@ contains
       end if
       call take_increment()
       if (allocated(err)) exit
-      if (refresh_next .or. .not. small_enough(rep, opts%tol)) then   ! (undone: not small)
+      if (refresh_next .or. .not. small_enough(rep, opts%tol)) then   ! (undone: not small enough)
         if (.not. refresh_next .and. near_enough(rep, set_start, contact)) then
           if (set_changed(stick=.false.)) call new_set()
           if (allocated(err)) exit
@@ -357,6 +357,8 @@ contains
     type(newton_report_t), intent(in) :: rep
     real(dp), intent(in) :: tol
     real(dp) :: rho, nrm
+    small_enough = .false.
+    if (rep%nincr < 1) return   ! (the only increment was undone)
     nrm = rep%incr(rep%nincr)
     small_enough = nrm <= tol
     if (small_enough .or. rep%nincr < 2) return
