@@ -188,19 +188,15 @@ contains
   !> near convergence, not converged) stick and slip are left for later: Coulomb's law has
   !> more than one consistent state, and a hoop rolling from node to node, whose stick or
   !> slip was decided early, made four times the energy in a step.
-  subroutine contact_settle(c, model, q, changed, stick)
+  subroutine contact_settle(c, model, q, stick, changed)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
+    logical, intent(in) :: stick
     integer, intent(out) :: changed
-    logical, intent(in), optional :: stick
     integer :: released, added
     changed = 0
-    if (.not. present(stick)) then
-      call friction_update(c, changed)
-    else if (stick) then
-      call friction_update(c, changed)
-    end if
+    if (stick) call friction_update(c, changed)
     if (changed > 0) return
     call contact_release(c, released)
     call contact_update(c, model, q, .true., added, reproject=.false.)

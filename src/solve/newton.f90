@@ -152,15 +152,16 @@ contains
       end if
       call take_increment()
       if (allocated(err)) exit
-      if (refresh_next .or. .not. small_enough(rep, opts%tol)) then   ! (undone: not small enough)
-        if (.not. refresh_next .and. near_enough(rep, set_start, contact)) then
+      if (refresh_next) cycle   ! (the increment was undone)
+      if (.not. small_enough(rep, opts%tol)) then
+        if (near_enough(rep, set_start, contact)) then
           if (set_changed(stick=.false.)) call new_set()
           if (allocated(err)) exit
         end if
         cycle
       end if
       if (residual_estimate() > max(opts%force_tol*fref, ffloor)) cycle
-      if (set_changed()) then
+      if (set_changed(stick=.true.)) then
         if (allocated(err)) exit
         call new_set()
         cycle
@@ -324,12 +325,12 @@ contains
     !> stick = .false.: near, not converged, stick and slip left for later). True when the
     !> set changed; an error when it keeps changing.
     logical function set_changed(stick)
-      logical, intent(in), optional :: stick
+      logical, intent(in) :: stick
       integer :: changed
       set_changed = .false.
       if (.not. present(contact)) return
       call timer_start(t_contact)
-      call contact_settle(contact, model, q, changed, stick)
+      call contact_settle(contact, model, q, stick, changed)
       call timer_stop(t_contact)
       set_changed = changed > 0
       if (set_changed .and. contact%changes >= max_set_changes) &
@@ -345,6 +346,7 @@ contains
 
   end subroutine newton_solve
 
+  !> The last increment over the one before
   real(dp) pure function contraction(rep)
     type(newton_report_t), intent(in) :: rep
     contraction = rep%incr(rep%nincr)/max(rep%incr(rep%nincr - 1), tiny(1._dp))
@@ -357,8 +359,6 @@ contains
     type(newton_report_t), intent(in) :: rep
     real(dp), intent(in) :: tol
     real(dp) :: rho, nrm
-    small_enough = .false.
-    if (rep%nincr < 1) return   ! (the only increment was undone)
     nrm = rep%incr(rep%nincr)
     small_enough = nrm <= tol
     if (small_enough .or. rep%nincr < 2) return
