@@ -11,7 +11,9 @@
 !> When the stabilising force is within Newton's own force tolerance the bodies have stopped:
 !> a last Newton solve without it gives the equilibrium exactly where the equilibrium is
 !> regular, and where it is not (a frictionless body free to slide under no sideways load)
-!> the stabilised state stands, in equilibrium within the tolerance. A body that nothing holds
+!> the stabilised state stands, in equilibrium within the tolerance. That solve is tried
+!> earlier too, from a stage Newton took easily while the force fell: a shell settling on
+!> its far branch after a snap-through does so slowly at the c its snap needed. A body that nothing holds
 !> against its load never stops (the damping goes on carrying a part of the load, and the
 !> body goes further than the scene's size), and is an error naming it.
 module casca_statics
@@ -118,8 +120,9 @@ contains
     real(dp), allocatable :: q_entry(:), q_n(:)
     type(constraint_t), allocatable :: act_entry(:)
     type(newton_opts_t) :: fresh
-    real(dp) :: c, c0, c_fail, fs, travel
+    real(dp) :: c, c0, c_fail, fs, travel, fs_before, fs_tried
     integer :: stage, iters, moving, k
+    logical :: settled, stopped
     character(len=300) :: msg
 
     allocate (q_entry, source=q)   ! (explicitly: gcc 12 warned of the descriptor)
@@ -130,6 +133,7 @@ contains
     fresh%reuse = .false.   ! (kept factors are of another c, or of the singular tangent)
     fresh%max_iter = min(opts%max_iter, 10)   ! (a stage that struggles: shorter pseudo-steps)
     iters = 0; moving = 0; fs = 0; c_fail = 0; unheld = .false.
+    fs_before = huge(1._dp); fs_tried = huge(1._dp)
     do stage = 1, max_stages
       call newton_solve(model, asm, ls, q, fext, fresh, rep, err, cm=c, qs=c*q_n, &
                         contact=contact, load_factor=factor)
@@ -143,12 +147,20 @@ contains
         cycle
       end if
       call stabilising_force(model, asm, q, q_n, c, fs, moving)
-      if (fs <= opts%force_tol*rep%force_scale) then
-        call unstabilised(iters)
-        rep%iters = iters
-        return
-      end if
+      stopped = fs <= opts%force_tol*rep%force_scale
       fs = fs/rep%force_scale
+      ! (also before the bodies stop: settling after a snap-through, at the c that a failed
+      ! stage left, the force falls by a few per cent a stage while the equilibrium is near;
+      ! tried again once the force has halved since the last try)
+      if (stopped .or. (rep%iters <= 3 .and. fs < fs_before .and. fs <= fs_tried/2)) then
+        fs_tried = fs
+        settled = unstabilised(iters)   ! (where not, the stopped state stands)
+        if (settled .or. stopped) then
+          rep%iters = iters
+          return
+        end if
+      end if
+      fs_before = fs
       q_n = q; c = max(c/stage_factor, 2*c_fail)
     end do
     ! (stages converged, the damping still carries a part of the scene's force, and a body
@@ -178,18 +190,20 @@ contains
     end if
   contains
     !> From the stabilised state, Newton without the stabilising force: the equilibrium
-    !> exactly, where it is regular. Where it is not (frictionless bodies free to slide
-    !> sideways under no sideways load) the stabilised state stands: its force is within
+    !> exactly, where it is regular (true), and rep is its report. Where it is not
+    !> (frictionless bodies free to slide sideways under no sideways load) q is left as it
+    !> was: at the end of the stages the stabilised state stands, its force within
     !> Newton's tolerance.
-    subroutine unstabilised(iters)
+    logical function unstabilised(iters)
       integer, intent(inout) :: iters
       type(newton_report_t) :: plain
       type(error_t), allocatable :: err_plain
       call newton_solve(model, asm, ls, q, fext, fresh, plain, err_plain, contact=contact, &
                         load_factor=factor)
       iters = iters + plain%iters
-      if (.not. allocated(err_plain) .and. plain%converged) rep = plain
-    end subroutine unstabilised
+      unstabilised = .not. allocated(err_plain) .and. plain%converged
+      if (unstabilised) rep = plain
+    end function unstabilised
   end subroutine stabilised_solve
 
   !> The first stage's c [1/s^2]: (E / rho) / L^2 for the stiffest material, so that c M is

@@ -1,0 +1,185 @@
+"""Sze, Liu & Lo (2004), tests 3.5, 3.6 and 3.8: cylinders and a cylindrical roof under point
+forces, in statics under load control, past their snap-throughs.
+
+usage: test_sze_shells.py CASCA WORK_DIR [CASE ...]
+  CASE (default all): pullout pinched roof
+
+Each cylinder is modelled by one eighth, from casca's defaults (10 load steps), cut from
+`casca mesh ring` (cubic triangles, cells never straddle the symmetry planes), with symmetry
+restraints (the normal position component and the fibre's normal component held on each
+plane). The tables are Sze's, as reproduced in
+MBDyn's test suite (github.com/zanoni-mbdyn/MBDyn, tests/plates/sze2004/sze35/sze35_ref.dat,
+sze36/sze36_ref.dat and sze38/sze38_ref_a.dat).
+
+pullout  test 3.5: an open-ended cylinder (R 4.953, L 10.35, h 0.094, E 10.5e6, nu 0.3125)
+         pulled apart by two radial forces P at mid-length, P_max = 40,000; the eighth
+         16 x 8 cells (256 elements). Its radial displacements (W_A, outwards at the loaded
+         point; -U_B, inwards at mid-length 90 degrees away; -U_C, inwards at the free edge
+         90 degrees away) at P / P_max = 0.5 (just before the snap of B) and 1 against Sze's
+         table (1%; Sze's mesh: 24 x 36 S4R on the eighth). A snap-through at 0.5 to 0.525
+         (-U_B jumps by 11%) is taken by the load steps' stabilised path.
+pinched  test 3.6: a cylinder (R 100, L 200, h 1, E 30,000, nu 0.3) on rigid end diaphragms
+         (radial and circumferential positions held at both ends), pinched by two opposite
+         radial forces P at mid-length, P_max = 12,000; the eighth 12 x 12 cells (288
+         elements). The shell snaps through several times on the way (Sze's -W_A jumps from
+         36.2 to 51.5 between P / P_max = 0.15 and 0.175); casca until 2026-11-27 stopped at
+         the first (exit 3 at 0.18), its stabilised stages settling too slowly on the far
+         branch. -W_A (inwards at the loaded point) and U_B (outwards at mid-length 90 degrees
+         away) against Sze's table (Sze's mesh: 48 x 48 S4R on the eighth): at P / P_max = 0.1,
+         before the snaps (1%), and at 1 (-W_A 1%, U_B 2%: this mesh's U_B is 1.5% above Sze's
+         there, the 16 x 16 mesh's 0.7%; between the snaps the meshes' paths differ by more,
+         their secondary snaps falling at other loads, so no intermediate load is asserted).
+
+roof     test 3.8: a hinged cylindrical roof (R 2540, 508 long, 0.1 rad either side of the
+         crown, h 12.7, E 3102.75, nu 0.3), its straight edges pinned, its curved edges free,
+         a point load P at its centre, P_max = 3000; the whole roof, 8 x 8 cells of casca's
+         plate mesh laid onto the cylinder, 20 load steps. Its load-deflection curve has a
+         limit point at P/P_max = 0.7421 (Sze), past which load control jumps to the far
+         branch: the jump must come in the load step that holds 0.7421 (the step before it
+         ends on the rising branch, -W_C below Sze's 11.293 at the limit; the step after it
+         beyond Sze's 26.601 at 0.6644 on the far branch); -W_C at Sze's points 0.5647 (5.802,
+         rising) and 0.9643 (28.663, far branch), casca's curve interpolated linearly between
+         its load steps 0.05 apart (1%).
+
+Every bound is against Sze's published table; none is copied from casca's output.
+"""
+import os
+import sys
+import time
+
+import meshio
+import numpy as np
+
+from casca_testlib import Checks, history, run
+
+casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
+CASES = sys.argv[3:] or ["pullout", "pinched"]
+os.makedirs(work, exist_ok=True)
+ck = Checks()
+
+
+def write_msh22(path, points, cells):
+    """A Gmsh 2.2 file of 10-node triangles (physical and geometrical tags 1)."""
+    ones = [np.ones(len(cells), dtype=int)]
+    meshio.write(path, meshio.Mesh(points, [("triangle10", cells)],
+                                   cell_data={"gmsh:physical": ones, "gmsh:geometrical": ones}),
+                 file_format="gmsh22", binary=False)
+    return path
+
+
+def generated(name, *args):
+    """`casca mesh ARGS`: its points and 10-node triangles."""
+    path = os.path.join(work, name + "_generated.msh")
+    p = run([casca, "mesh"] + [str(a) for a in args] + ["-o", path])
+    assert p.returncode == 0, p.stderr
+    m = meshio.read(path)
+    return m.points, [c.data for c in m.cells if c.type == "triangle10"][0]
+
+
+def octant_mesh(name, radius, length, n_quarter, n_half):
+    """One eighth of a cylinder (x, y, z >= 0; axis z, mid-length at z = 0): n_quarter cells
+    around the quarter, n_half along the half length, cut from `casca mesh ring`."""
+    points, cells = generated(name, "ring", "--radius", radius, "--width", length,
+                              "--n-around", 4 * n_quarter, "--n-across", 2 * n_half)
+    centre = points[cells[:, :3]].mean(axis=1)
+    keep = cells[np.all(centre > 0, axis=1)]
+    used = np.unique(keep)
+    new = np.full(len(points), -1)
+    new[used] = np.arange(len(used))
+    return write_msh22(os.path.join(work, name + ".msh"), points[used], new[keep])
+
+
+def run_static(name, deck_text):
+    """Write and run a static deck; returns the history (None when the run failed)."""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(deck_text)
+    out = os.path.join(work, name)
+    t0 = time.time()
+    p = run([casca, "run", deck, "--out", out, "-q"])
+    print("%s: %.1f s wall, exit %d" % (name, time.time() - t0, p.returncode), flush=True)
+    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr.strip()[-300:])
+    return history(out) if p.returncode == 0 else None
+
+
+def run_octant(name, mesh, material, load, extra, track):
+    """The eighth with its symmetry restraints and one point load at (radius, 0, 0), from the
+    defaults (10 load steps); returns the history (None when the run failed)."""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write("&run analysis = 'static' /\n")
+        f.write("&output vtu = .false., plots = .false., track = %s /\n"
+                % ", ".join("%.17g" % v for p in track for v in p))
+        f.write("&body name = 'tube', mesh = 'file', file = '%s', %s /\n" % (mesh, material))
+        for axis in "xyz":   # symmetry planes x = 0, y = 0, z = 0
+            box = ["1e9", "1e9", "1e9"]
+            box["xyz".index(axis)] = "1e-6"
+            f.write("&restraint body = 'tube', box_max = %s, fix = '%s g%s' /\n"
+                    % (", ".join(box), axis, axis))
+        f.write(extra)
+        r = track[0][0]
+        f.write("&load body = 'tube', box_min = %.17g, -1e-6, -1e-6, box_max = %.17g, 1e-6, 1e-6,"
+                " force = %.17g, 0, 0 /\n" % (r * (1 - 1e-6), r * (1 + 1e-6), load))
+    return run_static(name, open(deck).read())
+
+
+def at(h, factor, key):
+    i = int(np.argmin(np.abs(h["t"] - factor)))
+    assert abs(h["t"][i] - factor) < 1e-9, "no load step ends at %g" % factor
+    return h[key][i]
+
+
+if "pullout" in CASES:
+    R, L = 4.953, 10.35
+    mesh = octant_mesh("pullout", R, L, 16, 8)
+    # one eighth of each of the two forces P: a quarter of one
+    h = run_octant("pullout", mesh, "young = 10.5e6, poisson = 0.3125, density = 1.0, thickness = 0.094",
+                   40000.0 / 4, "", [(R, 0, 0), (0, R, 0), (0, R, L / 2)])
+    if h is not None:
+        # P / P_max: W_A, -U_B, -U_C (Sze's table)
+        for lf, ref in ((0.5, (2.473, 3.653, 3.718)), (1.0, (2.768, 4.551, 3.269))):
+            got = (at(h, lf, "p1_x") - R, R - at(h, lf, "p2_y"), R - at(h, lf, "p3_y"))
+            for label, g, r in zip(("W_A", "-U_B", "-U_C"), got, ref):
+                ck.close("pullout: %s at P/P_max = %g vs Sze et al. 2004 (%g)" % (label, lf, r), g, r, 0.01)
+
+if "pinched" in CASES:
+    R, L = 100.0, 200.0
+    mesh = octant_mesh("pinched", R, L, 12, 12)
+    diaphragm = "&restraint body = 'tube', box_min = -1e9, -1e9, %.17g, fix = 'x y' /\n" % (L / 2 * (1 - 1e-6))
+    h = run_octant("pinched", mesh, "young = 30.0e3, poisson = 0.3, density = 1.0, thickness = 1.0",
+                   -12000.0 / 4, diaphragm, [(R, 0, 0), (0, R, 0)])
+    if h is not None:
+        # P / P_max: -W_A, U_B, and the bounds
+        for lf, ref, tol in ((0.1, (23.164, -2.391), (0.01, 0.01)), (1.0, (83.102, 34.272), (0.01, 0.02))):
+            got = (R - at(h, lf, "p1_x"), at(h, lf, "p2_y") - R)
+            for label, g, r, t in zip(("-W_A", "U_B"), got, ref, tol):
+                ck.close("pinched: %s at P/P_max = %g vs Sze et al. 2004 (%g)" % (label, lf, r), g, r, t)
+
+if "roof" in CASES:
+    R, L, TH, N = 2540.0, 508.0, 0.1, 8
+    points, cells = generated("roof", "plate", "--lx", L, "--ly", 2 * R * TH, "--nx", N, "--ny", N)
+    s_arc = points[:, 1] - R * TH   # arc length from the crown: the plate wraps the cylinder
+    pts = np.c_[points[:, 0], R * np.sin(s_arc / R), R * np.cos(s_arc / R) - R]
+    mesh = write_msh22(os.path.join(work, "roof.msh"), pts, cells)
+    edge = R * np.sin(TH) * (1 - 1e-6)
+    h = run_static("roof", "&run analysis = 'static', load_steps = 20 /\n"
+                   "&output vtu = .false., plots = .false., track = %.17g, 0, 0 /\n"
+                   "&body name = 'roof', mesh = 'file', file = '%s',\n"
+                   "  young = 3102.75, poisson = 0.3, density = 1.0, thickness = 12.7 /\n"
+                   "&restraint body = 'roof', box_max = 1e9, %.17g, 1e9, fix = 'pinned' /\n"
+                   "&restraint body = 'roof', box_min = -1e9, %.17g, -1e9, fix = 'pinned' /\n"
+                   "&load body = 'roof', box_min = %.17g, -1e-6, -1e-6, box_max = %.17g, 1e-6, 1e-6,"
+                   " force = 0, 0, -3000 /\n"
+                   % (L / 2, mesh, -edge, edge, L / 2 * (1 - 1e-6), L / 2 * (1 + 1e-6)))
+    if h is not None:
+        lf, w = h["t"], -h["p1_z"]
+        k = int(np.searchsorted(lf, 0.7421 - 1e-12))   # the load step that holds the limit
+        ck.record("roof: load control leaves the rising branch in the load step holding Sze's "
+                  "limit 0.7421 (-W_C %.4g at %.3g below 11.293, %.4g at %.3g beyond 26.601)"
+                  % (w[k - 1], lf[k - 1], w[k], lf[k]), w[k - 1] < 11.293 and w[k] > 26.601)
+        rising, far = lf <= lf[k - 1] + 1e-12, lf >= lf[k] - 1e-12
+        for p_ref, w_ref, branch in ((0.5647, 5.802, rising), (0.9643, 28.663, far)):
+            ck.close("roof: -W_C at P/P_max = %g vs Sze et al. 2004 (%g)" % (p_ref, w_ref),
+                     np.interp(p_ref, lf[branch], w[branch]), w_ref, 0.01)
+
+ck.finish()
