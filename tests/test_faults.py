@@ -89,7 +89,17 @@ kdeck = deck("killed", out=kill_out)
 ckpt = os.path.join(kill_out, "checkpoint.h5")
 moments = [(10, 0.0, signal.SIGKILL), (40, 0.03, signal.SIGKILL), (70, 0.11, signal.SIGTERM),
            (110, 0.07, signal.SIGKILL), (150, 0.0, signal.SIGKILL)]
-killed_at, restarts_ok = [], True
+killed_at, restarts_ok, whole = [], True, []
+
+
+def whole_rows(path):
+    """Every line of a history.dat ends, and has the header's number of fields."""
+    text = open(path).read()
+    lines = text.splitlines()
+    n = len(lines[0].lstrip("#").split())
+    return text.endswith("\n") and all(len(line.split()) == n for line in lines[1:])
+
+
 for i, (after, wait, sig) in enumerate(moments):
     args = [casca, "run", kdeck, "-q"] + (["--restart", ckpt] if i > 0 else [])
     proc = subprocess.Popen(args, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -100,6 +110,8 @@ for i, (after, wait, sig) in enumerate(moments):
         proc.send_signal(sig)
     out_, err_ = proc.communicate()
     killed_at.append((ckpt_step(ckpt), proc.returncode))
+    if proc.returncode != 0:
+        whole.append(whole_rows(os.path.join(kill_out, "history.dat")))
     if i > 0 and not (proc.returncode < 0 or proc.returncode == 0):
         restarts_ok = False
         print("restart %d: exit %d: %s" % (i, proc.returncode, err_[-300:]))
@@ -109,6 +121,8 @@ ck.record("restarts after kill -9 / SIGTERM at %d moments accepted, the last end
           "checkpoint step and exit per kill %s; %s" % (killed_at, first_line(p)))
 ck.record("the runs were killed at different checkpoints (really interrupted)",
           len(set(s for s, c in killed_at if c < 0)) >= 3, str(killed_at))
+ck.record("each killed run's history.dat holds whole rows only (every line ends, with the "
+          "header's number of fields)", len(whole) >= 3 and all(whole), str(whole))
 h = np.loadtxt(os.path.join(kill_out, "history.dat"))
 ck.record("history.dat after the restarts has the uninterrupted run's steps",
           h.shape == ref.shape and np.array_equal(h[:, 1], ref[:, 1]), "%s vs %s" % (h.shape, ref.shape))

@@ -316,6 +316,9 @@ contains
     if (out%moving) row = [row, obstacle_work]
     write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
     call cf_write(out%hist, trim(line)//new_line('a'), err)
+    ! (each row to the system whole: a killed run's history.dat ends with a whole row, and a
+    ! running one can be plotted)
+    if (.not. allocated(err)) call cf_flush(out%hist, err)
     if (allocated(err)) return
     out%rows = out%rows + 1
     call h5_table_append(out%h5, row, err)
