@@ -53,7 +53,7 @@ import numpy as np
 from casca_testlib import Checks, history, run
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
-CASES = sys.argv[3:] or ["pullout", "pinched"]
+CASES = sys.argv[3:] or ["pullout", "pinched", "roof"]
 os.makedirs(work, exist_ok=True)
 ck = Checks()
 

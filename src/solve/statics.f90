@@ -33,7 +33,7 @@ module casca_statics
   private
   public :: static_solve
 
-  integer, parameter :: max_stages = 40      !< stabilised stages of one load step
+  integer, parameter :: max_stages = 100     !< stabilised stages of one load step
   real(dp), parameter :: stage_factor = 10    !< c's change from stage to stage
   real(dp), parameter :: max_damping = 1e4    !< c at most this times the first stage's
   real(dp), parameter :: unheld_part = 1e-3   !< of the scene's force the damping carries
@@ -133,7 +133,7 @@ contains
     fresh%reuse = .false.   ! (kept factors are of another c, or of the singular tangent)
     fresh%max_iter = min(opts%max_iter, 10)   ! (a stage that struggles: shorter pseudo-steps)
     iters = 0; moving = 0; fs = 0; c_fail = 0; unheld = .false.
-    fs_before = huge(1._dp); fs_tried = huge(1._dp)
+    fs_before = 0; fs_tried = huge(1._dp)
     do stage = 1, max_stages
       call newton_solve(model, asm, ls, q, fext, fresh, rep, err, cm=c, qs=c*q_n, &
                         contact=contact, load_factor=factor)
@@ -151,7 +151,7 @@ contains
       fs = fs/rep%force_scale
       ! (also before the bodies stop: settling after a snap-through, at the c that a failed
       ! stage left, the force falls by a few per cent a stage while the equilibrium is near;
-      ! tried again once the force has halved since the last try)
+      ! tried again once the force has halved since the last try, or after it rose again)
       if (stopped .or. (rep%iters <= 3 .and. fs < fs_before .and. fs <= fs_tried/2)) then
         fs_tried = fs
         settled = unstabilised(iters)   ! (where not, the stopped state stands)
@@ -160,6 +160,7 @@ contains
           return
         end if
       end if
+      if (fs > fs_before) fs_tried = huge(1._dp)   ! (rising: a fall after it settles anew)
       fs_before = fs
       q_n = q; c = max(c/stage_factor, 2*c_fail)
     end do
