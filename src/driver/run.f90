@@ -867,8 +867,10 @@ contains
     step_judged = r%st%step > merge(1, 0, r%held_at_start)
   end function step_judged
 
-  !> A run from t = 0 whose step made more than 1e-3 of E0 says so: no scheme casca offers
-  !> makes energy, so it is the contact's doing
+  !> A run from t = 0 whose step made more than 1e-3 of E0 says so: with contact active most
+  !> often the contact's doing; with none, the time scheme's, over a motion its steps do not
+  !> follow (the schemes keep or remove the energy of linear vibrations, not of every
+  !> nonlinear one)
   subroutine warn_energy(r)
     type(run_t), intent(in) :: r
     character(len=:), allocatable :: made, why
@@ -883,7 +885,12 @@ contains
     end if
     why = 'a node that came into a shell edge-on, through its rim (casca has no edge-to-edge '// &
           'contact), or deep into a target in one step; look at the frames there, or take a shorter dt'
-    if (allocated(r%contact)) then
+    if (r%made_contacts == 0) then
+      why = 'with no contact, the time scheme made it over a motion its steps do not follow, '// &
+            'as a spinning thin shell''s breathing under steps longer than its period (the '// &
+            'error estimate bounds the position, and a stiff shell holds much energy in a small '// &
+            'error); take a shorter dt, or a smaller tolerance'
+    else if (allocated(r%contact)) then
       if (r%contact%compliant) &   ! (a spring whose steps are too long for it)
         why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &
               rtoa(contact_time(r%deck, r%model, b)/r%deck%run%dt)//' steps of dt for body '''// &
