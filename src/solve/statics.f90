@@ -13,9 +13,9 @@
 !> regular, and where it is not (a frictionless body free to slide under no sideways load)
 !> the stabilised state stands, in equilibrium within the tolerance. That solve is tried
 !> earlier too, from a stage Newton took easily while the force fell: a shell settling on
-!> its far branch after a snap-through does so slowly at the c its snap needed. A body that nothing holds
-!> against its load never stops (the damping goes on carrying a part of the load, and the
-!> body goes further than the scene's size), and is an error naming it.
+!> its far branch after a snap-through does so slowly at the c its snap needed. A body that
+!> nothing holds against its load never stops (the damping goes on carrying a part of the
+!> load, and the body goes further than the scene's size), and is an error naming it.
 module casca_statics
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -154,7 +154,7 @@ contains
       ! tried again once the force has halved since the last try, or after it rose again)
       if (stopped .or. (rep%iters <= 3 .and. fs < fs_before .and. fs <= fs_tried/2)) then
         fs_tried = fs
-        settled = unstabilised(iters)   ! (where not, the stopped state stands)
+        call unstabilised(iters, settled)   ! (where not, the stopped state stands)
         if (settled .or. stopped) then
           rep%iters = iters
           return
@@ -191,20 +191,21 @@ contains
     end if
   contains
     !> From the stabilised state, Newton without the stabilising force: the equilibrium
-    !> exactly, where it is regular (true), and rep is its report. Where it is not
+    !> exactly, where it is regular (settled), and rep is its report. Where it is not
     !> (frictionless bodies free to slide sideways under no sideways load) q is left as it
     !> was: at the end of the stages the stabilised state stands, its force within
     !> Newton's tolerance.
-    logical function unstabilised(iters)
+    subroutine unstabilised(iters, settled)
       integer, intent(inout) :: iters
+      logical, intent(out) :: settled
       type(newton_report_t) :: plain
       type(error_t), allocatable :: err_plain
       call newton_solve(model, asm, ls, q, fext, fresh, plain, err_plain, contact=contact, &
                         load_factor=factor)
       iters = iters + plain%iters
-      unstabilised = .not. allocated(err_plain) .and. plain%converged
-      if (unstabilised) rep = plain
-    end function unstabilised
+      settled = .not. allocated(err_plain) .and. plain%converged
+      if (settled) rep = plain
+    end subroutine unstabilised
   end subroutine stabilised_solve
 
   !> The first stage's c [1/s^2]: (E / rho) / L^2 for the stiffest material, so that c M is
