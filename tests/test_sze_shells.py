@@ -50,7 +50,7 @@ import time
 import meshio
 import numpy as np
 
-from casca_testlib import Checks, history, run
+from casca_testlib import Checks, history, run, run_scene
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
 CASES = sys.argv[3:] or ["pullout", "pinched", "roof"]
@@ -90,37 +90,29 @@ def octant_mesh(name, radius, length, n_quarter, n_half):
 
 
 def run_static(name, deck_text):
-    """Write and run a static deck; returns the history (None when the run failed)."""
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write(deck_text)
-    out = os.path.join(work, name)
+    """Write and run a static deck (run_scene); returns the history (None when it failed)."""
     t0 = time.time()
-    p = run([casca, "run", deck, "--out", out, "-q"])
-    print("%s: %.1f s wall, exit %d" % (name, time.time() - t0, p.returncode), flush=True)
-    ck.record("%s: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr.strip()[-300:])
-    return history(out) if p.returncode == 0 else None
+    out, _ = run_scene(casca, ck, work, name, deck_text)
+    print("%s: %.1f s wall" % (name, time.time() - t0), flush=True)
+    return history(out) if out is not None else None
 
 
 def run_octant(name, mesh, material, load, extra, track):
     """The eighth with its symmetry restraints and one point load at (radius, 0, 0), from the
     defaults (10 load steps); returns the history (None when the run failed)."""
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write("&run analysis = 'static' /\n")
-        f.write("&output vtu = .false., plots = .false., track = %s /\n"
-                % ", ".join("%.17g" % v for p in track for v in p))
-        f.write("&body name = 'tube', mesh = 'file', file = '%s', %s /\n" % (mesh, material))
-        for axis in "xyz":   # symmetry planes x = 0, y = 0, z = 0
-            box = ["1e9", "1e9", "1e9"]
-            box["xyz".index(axis)] = "1e-6"
-            f.write("&restraint body = 'tube', box_max = %s, fix = '%s g%s' /\n"
-                    % (", ".join(box), axis, axis))
-        f.write(extra)
-        r = track[0][0]
-        f.write("&load body = 'tube', box_min = %.17g, -1e-6, -1e-6, box_max = %.17g, 1e-6, 1e-6,"
-                " force = %.17g, 0, 0 /\n" % (r * (1 - 1e-6), r * (1 + 1e-6), load))
-    return run_static(name, open(deck).read())
+    text = "&run analysis = 'static' /\n"
+    text += ("&output vtu = .false., plots = .false., track = %s /\n"
+             % ", ".join("%.17g" % v for p in track for v in p))
+    text += "&body name = 'tube', mesh = 'file', file = '%s', %s /\n" % (mesh, material)
+    for axis in "xyz":   # symmetry planes x = 0, y = 0, z = 0
+        box = ["1e9", "1e9", "1e9"]
+        box["xyz".index(axis)] = "1e-6"
+        text += "&restraint body = 'tube', box_max = %s, fix = '%s g%s' /\n" % (", ".join(box), axis, axis)
+    r = track[0][0]
+    text += extra
+    text += ("&load body = 'tube', box_min = %.17g, -1e-6, -1e-6, box_max = %.17g, 1e-6, 1e-6,"
+             " force = %.17g, 0, 0 /\n" % (r * (1 - 1e-6), r * (1 + 1e-6), load))
+    return run_static(name, text)
 
 
 def at(h, factor, key):
