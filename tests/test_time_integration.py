@@ -46,14 +46,20 @@ restart      the adaptive rings to 10 ms with checkpoints every 5 ms, and the sa
              largest value): the checkpoint carries the next step's length.
 breathing    a thin steel sphere (R 0.08 m, h 2 mm, n_div 3) flying and spinning at 40 rad/s,
              no contact, rho_inf 0.5 with tolerance 1e-4, 5 ms: its breathing period (about
-             60 us) is far shorter than the chosen steps (up to 1 ms), and the scheme made
-             1% of E0 in a step over it. Where a step made more than 1e-3 of E0 (the
-             history's largest one-step rise of kinetic + strain - work), the end warning
-             must name no contact and the time scheme (not an edge-on contact), its step time
-             and figure equal to that rise (1e-4 s, 1e-3 relative); where none did, no
-             warning. With steps of 20 us
-             (rho_inf 0.8) the balance's remainder stays within 1e-5 of E0 (conservation,
-             the control).
+             60 us) is far shorter than the steps the position's error estimate allows, and
+             over steps of 0.5 to 1 ms the scheme gave it a strain of order (omega dt)^2
+             that it kept (0.12 J, 0.6% of E0; casca before 2026-11-27 made 1% of E0 in a
+             step here). With no contact active the energy a step makes is bounded by the
+             tolerance too: the history's largest one-step rise of kinetic + strain - work is
+             at most 1e-4 of the kinetic + strain energy there, and E stays within 1e-3 of
+             E0 over the run (conservation: free flight under gravity keeps it); no warning.
+breathing_fixed  the same sphere at a fixed dt of 1 ms (no tolerance): the steps make
+             energy (cut once to 0.5 ms for more than 1%, and kept). The history's largest
+             one-step rise is above 1e-3 of E0, and the end warning must name no contact and
+             the time scheme (not an edge-on contact) and advise a tolerance, its step time
+             and figure equal to that rise (1e-4 s, 1e-3 relative).
+             With steps of 20 us (rho_inf 0.8, breathing_resolved) the balance's remainder
+             stays within 1e-5 of E0 (conservation, the control).
 deck         rho_inf given with beta is refused (exit 2, the message names &run, rho_inf and
              beta); rho_inf = 1.5 and tolerance = -1 are refused naming the field.
 """
@@ -220,18 +226,25 @@ h, err = breathing("breathing", "dt = 1e-4, tolerance = 1e-4, rho_inf = 0.5")
 if h is not None:
     rise = np.diff(h["total"])
     k = int(np.argmax(rise))
+    ck.le("breathing: the largest one-step rise of E over the kinetic + strain energy then",
+          rise[k] / (h["kinetic"][k + 1] + h["strain"][k + 1]), 1e-4)
+    ck.le("breathing: max |E - E0| / E0 of kinetic + strain - work",
+          np.max(np.abs(h["total"] - h["total"][0])) / h["total"][0], 1e-3)
+    ck.record("breathing: no energy warning", "warning: the step" not in err, err[-300:])
+h, err = breathing("breathing_fixed", "dt = 1e-3, rho_inf = 0.5")
+if h is not None:
+    rise = np.diff(h["total"])
+    k = int(np.argmax(rise))
+    ck.le("breathing_fixed: the largest one-step rise over E0 exceeds 1e-3 (the warning's threshold)",
+          1e-3, rise[k] / h["total"][0])
     m = re.search(r"warning: the step to t = (\S+) s made (\S+)% of the initial energy, with 0 contacts"
-                  r" active: with no contact, the time scheme", err)
-    if rise[k] <= 1e-3 * h["total"][0]:   # (a scheme that makes none here need not warn)
-        ck.record("breathing: no step made 1e-3 of E0 (%.3g), and no warning" % (rise[k] / h["total"][0]),
-                  "warning: the step" not in err, err[-300:])
-    else:
-        ck.record("breathing: the energy warning names no contact and the time scheme", m is not None,
-                  err[-300:])
+                  r" active: with no contact, the time scheme.*give a tolerance", err, re.S)
+    ck.record("breathing_fixed: the energy warning names no contact and the time scheme, and advises a "
+              "tolerance", m is not None, err[-300:])
     if m is not None:
-        ck.close("breathing: the warning's step time vs the history's largest one-step rise [s]",
+        ck.close("breathing_fixed: the warning's step time vs the history's largest one-step rise [s]",
                  float(m.group(1)), h["t"][k + 1], 1e-4)
-        ck.close("breathing: the warning's figure vs that rise / E0 [%]", float(m.group(2)),
+        ck.close("breathing_fixed: the warning's figure vs that rise / E0 [%]", float(m.group(2)),
                  100 * rise[k] / h["total"][0], 1e-3)
 h, err = breathing("breathing_resolved", "dt = 2e-5, rho_inf = 0.8")
 if h is not None:

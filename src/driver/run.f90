@@ -15,7 +15,7 @@ module casca_run
   use casca_newmark, only: state_t, newmark_step
   use casca_statics, only: static_solve
   use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
-  use casca_step_control, only: step_control_t, local_error, next_step_ratio
+  use casca_step_control, only: step_control_t, local_error, energy_error, next_step_ratio
   use casca_step_size, only: time_to_contact
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance, balance_remainder
@@ -61,6 +61,10 @@ module casca_run
     type(step_control_t) :: sc                  !< steps by an error estimate (tol > 0)
     real(dp) :: dt_try = 0                      !< with sc: the next step's length
     logical :: onset = .false.                  !< with sc: a contact begins at this step's end or start
+    !> with sc: a step this long made too much energy with no contact active; shorter ones
+    !> until a contact is active or a checkpoint is written (a restart starts without it, as
+    !> the run it continues had there)
+    real(dp) :: dt_cap = huge(1._dp)
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
     !> the energy a step made (the remainder of the balance fell): the largest, when, and the
     !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
@@ -263,9 +267,10 @@ contains
     type(balance_t) :: bal_before
     real(dp) :: rest, made
     !> a step that makes more energy than this share of what the bodies hold is taken again
-    !> with half the step (as one where Newton fails): no scheme casca offers makes energy,
-    !> so it is the contact's doing or a mode the step cannot follow; a tenth of this share
-    !> is still warned of at the end (warn_energy)
+    !> with half the step (as one where Newton fails): the schemes keep or remove the energy
+    !> of linear vibrations, so it is the contact's doing or a motion the step cannot follow;
+    !> a tenth of this share is still warned of at the end (warn_energy). With a tolerance,
+    !> free steps are held to a tighter share (energy_accepted)
     real(dp), parameter :: made_limit = 1e-2_dp
     !> guarded: the balance is exact step by step (not so for the work of moving obstacles,
     !> counted as their velocity times the step's impulse, nor for pressures on open
@@ -309,6 +314,16 @@ contains
         call timer_stop(t_account)
         rest = rest_now(r)
         made = r%rest_last - rest
+        if (r%sc%tol > 0 .and. guarded) then
+          if (touching()) then
+            r%dt_cap = huge(1._dp)
+          else if (step_judged(r)) then
+            if (.not. energy_accepted(r, made, energy_scale())) then
+              call undo_step()
+              cycle
+            end if
+          end if
+        end if
         if (guarded .and. .not. energy_cut .and. step_judged(r) .and. &
             made > made_limit*energy_scale() .and. r%level < deck%run%max_step_cuts) then
           call undo_step()
@@ -345,6 +360,12 @@ contains
       r%st = st_before; r%bal = bal_before
       if (allocated(r%contact)) r%contact = contact_before
     end subroutine undo_step
+
+    !> a contact active at the step's start or end (its energy has the cut above instead)
+    logical function touching()
+      touching = .false.
+      if (allocated(r%contact)) touching = r%contact%nact > 0 .or. contact_before%nact > 0
+    end function touching
 
     !> what the bodies hold (kinetic and strain energy) or the loads did, before or after
     !> the step: within a step, so that a restart judges its steps as the run it continues
@@ -416,6 +437,7 @@ contains
     real(dp) :: dt
     ok = .false.
     dt = r%deck%run%dt
+    if (r%st%t >= next_ckpt - 1e-6_dp*dt) r%dt_cap = huge(1._dp)
     call timer_start(t_output)
     call history_row(r, r%rep%iters)
     call timer_stop(t_output)
@@ -492,7 +514,7 @@ contains
         h = min(h, t_end - st%t)
         return
       end if
-      h = level(r%dt_try)
+      h = level(min(r%dt_try, (1 - 1e-6_dp)*r%dt_cap))
       h = min(next_multiple(st%t, h) - st%t, t_end - st%t)
       r%onset = .false.
       if (.not. allocated(r%contact)) return
@@ -563,6 +585,25 @@ contains
       end do
     end subroutine touching
   end function step_accepted
+
+  !> Whether the step's energy is within the tolerance while no contact is active
+  !> (casca_step_control's energy_error): if not, it is taken again shorter, and later steps
+  !> are shorter too (dt_cap); if so, the next step is no longer than the energy allows
+  logical function energy_accepted(r, made, scale) result(ok)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(in) :: made, scale
+    real(dp) :: err, ratio, h
+    h = r%nm%dt
+    err = energy_error(r%sc, made, scale)
+    ratio = next_step_ratio(r%sc, err)
+    ok = err <= 1 .or. h <= r%sc%dt_min
+    if (.not. ok) then
+      r%dt_try = max(h*ratio, r%sc%dt_min)
+      r%dt_cap = h   ! (it would be tried again as soon as a shorter one makes little)
+    else if (ratio < r%sc%grow) then
+      r%dt_try = min(r%dt_try, max(h*ratio, r%sc%dt_min))
+    end if
+  end function energy_accepted
 
   !> Leave the bodies that need no solving this step out of the equations (re-analysed
   !> only when that set changes).
@@ -887,9 +928,14 @@ contains
           'contact), or deep into a target in one step; look at the frames there, or take a shorter dt'
     if (r%made_contacts == 0) then
       why = 'with no contact, the time scheme made it over a motion its steps do not follow, '// &
-            'as a spinning thin shell''s breathing under steps longer than its period (the '// &
-            'error estimate bounds the position, and a stiff shell holds much energy in a small '// &
-            'error); take a shorter dt, or a smaller tolerance'
+            'as a spinning thin shell''s breathing under steps longer than its period (a stiff '// &
+            'shell holds much energy in a small error); '
+      if (r%sc%tol > 0) then   ! (with moving obstacles or pressures: not bounded step by step)
+        why = why//'take a smaller tolerance'
+      else
+        why = why//'take a shorter dt, or give a tolerance (&run), which also bounds the '// &
+              'energy a step makes while no contact is active'
+      end if
     else if (allocated(r%contact)) then
       if (r%contact%compliant) &   ! (a spring whose steps are too long for it)
         why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &

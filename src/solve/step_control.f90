@@ -5,6 +5,11 @@
 !> The nodes of the contacts active at the step's end are left out (the caller's skip): their
 !> acceleration follows the contact force, which jumps where it starts; a contact that ended
 !> within the step counts.
+!> While no contact is active a step must also not make energy: what it made (the energy
+!> balance's remainder fell) over tolerance times the energy the bodies hold counts as an
+!> error too (energy_error). A free body spinning under steps far longer than its breathing
+!> period took a steady strain of order (omega dt)^2 that its acceleration does not show: a
+!> steel ball at 40 rad/s and 0.5 ms steps held 0.12 J of it, 0.6% of its energy.
 !> The local error is O(dt^3), so the next step is dt (safety / err)^(1/3), within a growth
 !> and a shrink limit; a step whose error is above 1 is taken again shorter (casca_run, which
 !> also ends steps at a predicted contact and rounds the length down to the frame interval
@@ -15,7 +20,7 @@ module casca_step_control
   use casca_time_scheme, only: scheme_t
   implicit none
   private
-  public :: step_control_t, local_error, next_step_ratio
+  public :: step_control_t, local_error, energy_error, next_step_ratio
 
   type :: step_control_t
     real(dp) :: tol = 0           !< <= 0: fixed steps (the deck's dt, halved on failure)
@@ -47,6 +52,13 @@ contains
     end do
     err = ts%error_coefficient()*ts%dt**2*e/(sc%tol*sc%length)
   end function local_error
+
+  !> The energy a step made over the tolerance times the energy the bodies hold (scale)
+  pure real(dp) function energy_error(sc, made, scale) result(err)
+    type(step_control_t), intent(in) :: sc
+    real(dp), intent(in) :: made, scale
+    err = made/(sc%tol*max(scale, tiny(1._dp)))
+  end function energy_error
 
   !> The factor of the next step from the error of the last
   pure real(dp) function next_step_ratio(sc, err) result(ratio)
