@@ -48,9 +48,18 @@ module casca_linear_system
     integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
     type(mass_solver_t) :: mass                !< M by component, for the contact correction
     type(correction_cache_t) :: correction     !< its last C M^-1 C^T, factorised
+    !> Kept factors that fail at a step's start (refreshed at its second or third Newton
+    !> iteration) start the next fresh_run steps with fresh factors, then are tried again
+    !> (a probe); the run doubles while probes fail (a thin plate tumbling at 30 rad/s: its
+    !> fibres' stiffness turns with it, and last step's factors made every first increment
+    !> worse, three factorisations a step instead of one)
+    integer :: fresh_left = 0, fresh_run = 0
+    logical :: probing = .false.
   contains
     procedure :: finish => system_finish
     procedure :: drop_factors => system_drop_factors
+    procedure :: start_with_kept => system_start_with_kept
+    procedure :: judge_probe => system_judge_probe
     procedure :: new_pattern => system_new_pattern
   end type linear_system_t
 
@@ -254,7 +263,33 @@ contains
       self%choice = fresh
       self%schur = .true.
     end if
+    self%fresh_left = 0; self%fresh_run = 0; self%probing = .false.
   end subroutine system_drop_factors
+
+  !> At a step's first Newton iteration, with factors kept: use them (a probe of them), or
+  !> not, while a failed probe's run of fresh starts lasts. A probe still open here passed
+  !> (its step converged on them).
+  logical function system_start_with_kept(self) result(keep)
+    class(linear_system_t), intent(inout) :: self
+    if (self%probing) self%fresh_run = 0
+    keep = self%fresh_left == 0
+    self%probing = keep
+    if (.not. keep) self%fresh_left = self%fresh_left - 1
+  end function system_start_with_kept
+
+  !> The open probe's outcome: its step refreshed the factors early (failed) or not
+  subroutine system_judge_probe(self, refreshed)
+    class(linear_system_t), intent(inout) :: self
+    logical, intent(in) :: refreshed
+    if (.not. self%probing) return
+    self%probing = .false.
+    if (refreshed) then
+      self%fresh_run = min(64, max(1, 2*self%fresh_run))
+      self%fresh_left = self%fresh_run
+    else
+      self%fresh_run = 0
+    end if
+  end subroutine system_judge_probe
 
   !> The unknowns changed: the next solve analyses again.
   subroutine system_new_pattern(self)

@@ -133,7 +133,7 @@ contains
       call analyse_blocks(ls, model, asm, rows, rep%analyses, err)
       call timer_stop(t_analysis)
       if (allocated(err)) exit
-      fresh = refresh_needed()
+      fresh = refresh_needed(ls, opts, rep, it, set_start, nc, refresh_next)
       call timer_start(t_assembly)
       call assemble(model, asm, q, fresh, r, rep%energy, cm, qs, qn, af)
       r = r - fext
@@ -221,22 +221,6 @@ contains
       residual_estimate = rnorm
       if (rep%nincr >= 2) residual_estimate = rnorm*min(1._dp, contraction(rep))
     end function residual_estimate
-
-    !> a new matrix unless the kept one still contracts the increment fast enough (decided
-    !> from replicated figures, so alike on every rank). With constraints, slow contraction
-    !> comes first from the rows (their normal is held): Z is renewed first, K only if
-    !> contraction stays poor. Increments of two active sets say nothing of the factors.
-    logical function refresh_needed()
-      refresh_needed = refresh_next .or. .not. (opts%reuse .and. ls%solver(1)%factored)
-      refresh_next = .false.
-      if (refresh_needed .or. rep%nincr < set_start + 1) return
-      if (ls%schur .and. nc > 0) then
-        if (rep%nincr >= 3) refresh_needed = contraction(rep) > 0.5_dp
-      else
-        refresh_needed = contraction(rep) > 0.25_dp
-      end if
-      if (it > 8) refresh_needed = .true.
-    end function refresh_needed
 
     !> Judge the last increment by the residual it led to (same active set only): undo a
     !> step of kept factors that did not lower the residual (fresh factors next), shorten a
@@ -345,6 +329,35 @@ contains
     end function gap_open
 
   end subroutine newton_solve
+
+  !> A new matrix unless the kept one still contracts the increment fast enough (decided
+  !> from replicated figures, so alike on every rank). With constraints, slow contraction
+  !> comes first from the rows (their normal is held): Z is renewed first, K only if
+  !> contraction stays poor. Increments of two active sets say nothing of the factors.
+  !> A step's first iteration uses kept factors as ls's probes allow, and its second and
+  !> third judge them, while the active set is the step's first.
+  logical function refresh_needed(ls, opts, rep, it, set_start, nc, refresh_next) result(fresh)
+    type(linear_system_t), intent(inout) :: ls
+    type(newton_opts_t), intent(in) :: opts
+    type(newton_report_t), intent(in) :: rep
+    integer, intent(in) :: it, set_start, nc
+    logical, intent(inout) :: refresh_next
+    fresh = refresh_next .or. .not. (opts%reuse .and. ls%solver(1)%factored)
+    refresh_next = .false.
+    if (it == 1) then
+      if (fresh) call ls%judge_probe(.false.)   ! (an open probe's step converged on them)
+      if (.not. fresh) fresh = .not. ls%start_with_kept()
+    end if
+    if (.not. fresh .and. rep%nincr >= set_start + 1) then
+      if (ls%schur .and. nc > 0) then
+        if (rep%nincr >= 3) fresh = contraction(rep) > 0.5_dp
+      else
+        fresh = contraction(rep) > 0.25_dp
+      end if
+      if (it > 8) fresh = .true.
+    end if
+    if (it >= 2 .and. set_start == 1 .and. (fresh .or. it >= 3)) call ls%judge_probe(fresh)
+  end function refresh_needed
 
   !> The last increment over the one before
   real(dp) pure function contraction(rep)
