@@ -139,16 +139,19 @@ contains
       r = r - fext
       call add_pressure(model, asm, q, fresh, r, fpress, load_factor, qn, af)   ! pressure (issue 17)
       call timer_stop(t_assembly)
+      call full_residual()
+      if (it > 1) then   ! (judged before factorising: an iterate left is not factorised)
+        if (undo_or_shorten()) then
+          refresh_next = refresh_next .or. fresh
+          cycle
+        end if
+      end if
       if (fresh) then
         call timer_start(t_factor)
         call factorise_blocks(ls, asm, rows, err)
         call timer_stop(t_factor)
         if (allocated(err)) exit
         rep%factorisations = rep%factorisations + 1
-      end if
-      call full_residual()
-      if (it > 1) then
-        if (undo_or_shorten()) cycle
       end if
       call take_increment()
       if (allocated(err)) exit
