@@ -211,6 +211,11 @@ if p1.returncode == p2.returncode == p3.returncode == 0:
         ck.le("restart: largest difference of a column over its largest value", worst, 1e-12)
 
 
+def energy_drift(h):
+    """max |E - E0| / E0 of the history's total (kinetic + strain - work of loads)."""
+    return np.max(np.abs(h["total"] - h["total"][0])) / h["total"][0]
+
+
 def breathing(name, run_line):
     """The spinning thin sphere; returns (history, standard error)."""
     deck = os.path.join(work, name + ".nml")
@@ -234,7 +239,7 @@ if h is not None:
     ck.le("breathing: the largest one-step rise of E over the kinetic + strain energy then",
           rise[k] / (h["kinetic"][k + 1] + h["strain"][k + 1]), 1e-4)
     ck.le("breathing: max |E - E0| / E0 of kinetic + strain - work",
-          np.max(np.abs(h["total"] - h["total"][0])) / h["total"][0], 1e-3)
+          energy_drift(h), 1e-3)
     ck.record("breathing: no energy warning", "warning: the step" not in err, err[-300:])
 h, err = breathing("breathing_fixed", "dt = 1e-3, rho_inf = 0.5")
 if h is not None:
@@ -254,7 +259,7 @@ if h is not None:
 h, err = breathing("breathing_resolved", "dt = 2e-5, rho_inf = 0.8")
 if h is not None:
     ck.le("breathing_resolved (20 us): max |E - E0| / E0 of kinetic + strain - work",
-          np.max(np.abs(h["total"] - h["total"][0])) / h["total"][0], 1e-5)
+          energy_drift(h), 1e-5)
     ck.record("breathing_resolved: no energy warning", "warning: the step" not in err, err[-300:])
 
 
@@ -267,7 +272,7 @@ out, _ = run_scene(casca, ck, work, "tumbling", """&run dt = 1e-4, t_end = 0.02,
 if out is not None:
     h = history(out)
     ck.le("tumbling: max |E - E0| / E0 of kinetic + strain",
-          np.max(np.abs(h["total"] - h["total"][0])) / h["total"][0], 1e-3)
+          energy_drift(h), 1e-3)
 
 
 def refused(name, run_line, words):

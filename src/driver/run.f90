@@ -315,7 +315,7 @@ contains
         rest = rest_now(r)
         made = r%rest_last - rest
         if (r%sc%tol > 0 .and. guarded) then
-          if (touching()) then
+          if (in_contact()) then
             r%dt_cap = huge(1._dp)
           else if (step_judged(r)) then
             if (.not. energy_accepted(r, made, energy_scale())) then
@@ -362,10 +362,10 @@ contains
     end subroutine undo_step
 
     !> a contact active at the step's start or end (its energy has the cut above instead)
-    logical function touching()
-      touching = .false.
-      if (allocated(r%contact)) touching = r%contact%nact > 0 .or. contact_before%nact > 0
-    end function touching
+    logical function in_contact()
+      in_contact = .false.
+      if (allocated(r%contact)) in_contact = r%contact%nact > 0 .or. contact_before%nact > 0
+    end function in_contact
 
     !> what the bodies hold (kinetic and strain energy) or the loads did, before or after
     !> the step: within a step, so that a restart judges its steps as the run it continues
@@ -437,7 +437,6 @@ contains
     real(dp) :: dt
     ok = .false.
     dt = r%deck%run%dt
-    if (r%st%t >= next_ckpt - 1e-6_dp*dt) r%dt_cap = huge(1._dp)
     call timer_start(t_output)
     call history_row(r, r%rep%iters)
     call timer_stop(t_output)
@@ -794,7 +793,9 @@ contains
   subroutine checkpoint(r)
     type(run_t), intent(inout) :: r
     type(error_t), allocatable :: e
-    call r%ls%drop_factors()   ! on every rank: a restart from here starts with new factors
+    ! on every rank: a restart from here starts with new factors and no energy cap
+    call r%ls%drop_factors()
+    r%dt_cap = huge(1._dp)
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
     if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e, &
                                                   r%dt_try)
