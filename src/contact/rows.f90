@@ -82,7 +82,7 @@ contains
   !> each multiplier (zero, or minus a compliant normal row's compliance), the rows' residuals
   !> (the gaps, less compliance times lambda), and each row's key (node and kind, element).
   !> fval: the same entries of the columns the multipliers act through: C^T where the force
-  !> acts (force_point), and for a sliding constraint's normal row n - mu_d s on its points
+  !> acts (force_point), and for a sliding constraint's normal row n - mu_d s there
   !> (its friction follows |lambda|).
   subroutine contact_rows(c, model, eq, neq, irn, jcn, val, gap, key, fval)
     type(contact_t), intent(in) :: c
@@ -111,7 +111,7 @@ contains
         mu = 0; ns = 0
         if (kind == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
           mu = c%mu_d(c%act(k)%pair); key(1, r) = 4*c%act(k)%node + 3
-          call constraint_row(c%act(k), model, d, vs, ns, 3)   ! (the same points first)
+          call constraint_row(c%act(k), model, d, vs, ns, 3, force=.true.)   ! (the same points first)
         end if
         do j = 1, nd
           if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
@@ -133,8 +133,8 @@ contains
     if (a%grip == slip) slip_force = c%mu_d(a%pair)*max(-a%lambda, 0._dp)
   end function slip_force
 
-  !> f = C^T lambda (ndof) with the sliding friction: minus the contact forces, on the fibres
-  !> too between faces
+  !> f = C^T lambda (ndof) with the friction: minus the contact forces, on the fibres too
+  !> between faces, every row where the force acts (force_point)
   subroutine contact_generalized_force(c, model, f)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
@@ -147,12 +147,12 @@ contains
         call constraint_row(a, model, d, v, nd, force=.true.)
         f(d(1:nd)) = f(d(1:nd)) + a%lambda*v(1:nd)
         if (a%grip == stick) then
-          call constraint_row(a, model, d, v, nd, 1)
+          call constraint_row(a, model, d, v, nd, 1, force=.true.)
           f(d(1:nd)) = f(d(1:nd)) + a%lt(1)*v(1:nd)
-          call constraint_row(a, model, d, v, nd, 2)
+          call constraint_row(a, model, d, v, nd, 2, force=.true.)
           f(d(1:nd)) = f(d(1:nd)) + a%lt(2)*v(1:nd)
         else if (a%grip == slip) then
-          call constraint_row(a, model, d, v, nd, 3)
+          call constraint_row(a, model, d, v, nd, 3, force=.true.)
           f(d(1:nd)) = f(d(1:nd)) + slip_force(c, a)*v(1:nd)
         end if
       end associate
