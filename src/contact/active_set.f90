@@ -5,7 +5,8 @@ module casca_contact_active_set
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
   use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds
-  use casca_contact_projection, only: positions, body_box, project, constraint_geometry
+  use casca_contact_projection, only: positions, body_box, project, constraint_geometry, normal_cache_t, &
+                                      normal_cache
   use casca_contact_friction, only: friction_on, friction_update
   implicit none
   private
@@ -29,18 +30,20 @@ contains
     integer :: ip, bi, bt, n, k
     logical :: found
     type(constraint_t) :: cn
+    type(normal_cache_t) :: normals
 
     added = 0
     allocate (x(3, model%nnode))
     x = positions(model, q)
     c%geo%grid_ok = .false.
+    if (c%nodal_normal) call normal_cache(model, normals)
     ! active constraints: project again (the target moves and the node slides), or with
     ! reproject = .false. hold the point
     do k = 1, c%nact
       if (c%act(k)%grip == 0 .and. friction_on(c, c%act(k)%pair)) c%act(k)%grip = stick   ! (restart)
       if (present(reproject) .and. (c%pair(2, c%act(k)%pair) <= 0 .or. c%act(k)%elem > 0)) then
         if (.not. reproject) then
-          call constraint_geometry(c, model, x, q, c%act(k)); cycle
+          call constraint_geometry(c, model, x, q, c%act(k), normals); cycle
         end if
       end if
       if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
@@ -57,7 +60,7 @@ contains
           c%act(k)%elem = 0; cycle
         end if
       end if
-      call constraint_geometry(c, model, x, q, c%act(k))
+      call constraint_geometry(c, model, x, q, c%act(k), normals)
     end do
     if (.not. detect) return
     do ip = 1, c%npairs
@@ -99,10 +102,10 @@ contains
     subroutine take(cn)
       type(constraint_t), intent(inout) :: cn
       if (friction_on(c, cn%pair)) cn%grip = stick
-      call constraint_geometry(c, model, x, q, cn)
+      call constraint_geometry(c, model, x, q, cn, normals)
       if (c%stick_at_touch .and. cn%grip == stick) then   ! (its slip so far is not stuck)
         cn%u0 = cn%ut
-        call constraint_geometry(c, model, x, q, cn)
+        call constraint_geometry(c, model, x, q, cn, normals)
       end if
       if (cn%gap < -c%tol) then
         if (edge_on(cn)) return
