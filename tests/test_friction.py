@@ -201,10 +201,9 @@ if h is not None:
 
 # friction between two free bodies: the angular momentum is kept in the limit
 sph = {}
-for name, k in (("shell", 3), ("ball", 2)):
-    sph[name] = os.path.join(work, "sphere_%d.msh" % k)
-    run([casca, "mesh", "sphere", "--radius", "0.2" if name == "shell" else "0.05", "--n-div", str(k),
-         "-o", sph[name]])
+for name, radius, k in (("shell", 0.2, 3), ("ball", 0.05, 2)):
+    sph[name] = os.path.join(work, "%s.msh" % name)
+    run([casca, "mesh", "sphere", "--radius", str(radius), "--n-div", str(k), "-o", sph[name]])
 drift = {}
 for dt in (2e-5, 1e-5):
     h, _ = go("rattle_%g" % dt, f"""&run dt = {dt}, t_end = 0.003, rho_inf = 1.0, newton_tol = 1e-13 /

@@ -321,8 +321,8 @@ contains
   !> the offset: the faces touch, and stick or slide, where they are. force: the row as the
   !> force acts, at shpf, friction included (at the gap's point, half a step's slide away,
   !> the friction pair had a moment: a spinning ball rattling in a shell lost 2.9e-4 of L
-  !> in one impact, 3.5e-6 at shpf, test_friction 'rattle'). (The correction's mass solves need the scalar row only:
-  !> one column per row, not one per component.)
+  !> in one impact, 3.5e-6 at shpf, test_friction 'rattle'). (The correction's mass solves
+  !> need the scalar row only: one column per row, not one per component.)
   pure subroutine row_factors(a, model, kind, force, node, par, w, nw, dir)
     type(constraint_t), intent(in) :: a
     type(model_t), intent(in) :: model

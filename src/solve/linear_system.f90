@@ -266,12 +266,10 @@ contains
     self%fresh_left = 0; self%fresh_run = 0; self%probing = .false.
   end subroutine system_drop_factors
 
-  !> At a step's first Newton iteration, with factors kept: use them (a probe of them), or
-  !> not, while a failed probe's run of fresh starts lasts. A probe still open here passed
-  !> (its step converged on them).
+  !> At a step's first Newton iteration, with factors kept and the last probe judged: use
+  !> them (a probe of them), or not, while a failed probe's run of fresh starts lasts.
   logical function system_start_with_kept(self) result(keep)
     class(linear_system_t), intent(inout) :: self
-    if (self%probing) self%fresh_run = 0
     keep = self%fresh_left == 0
     self%probing = keep
     if (.not. keep) self%fresh_left = self%fresh_left - 1

@@ -348,7 +348,7 @@ contains
     fresh = refresh_next .or. .not. (opts%reuse .and. ls%solver(1)%factored)
     refresh_next = .false.
     if (it == 1) then
-      if (fresh) call ls%judge_probe(.false.)   ! (an open probe's step converged on them)
+      call ls%judge_probe(.false.)   ! (a probe still open passed: its step converged on them)
       if (.not. fresh) fresh = .not. ls%start_with_kept()
     end if
     if (.not. fresh .and. rep%nincr >= set_start + 1) then
