@@ -73,6 +73,18 @@ def momentum_error(h):
     return np.max(np.linalg.norm(p - p[0], axis=1)) / np.linalg.norm(p[0])
 
 
+def angular_momentum(h):
+    """The total angular momentum about the origin at each row, shape (rows, 3)."""
+    return np.stack([h["Lx"], h["Ly"], h["Lz"]]).T
+
+
+def angular_drift(h, scale=None):
+    """Largest change of the total angular momentum over the run, max |L - L0|, over scale
+    (default |L0|)."""
+    L = angular_momentum(h)
+    return np.max(np.linalg.norm(L - L[0], axis=1)) / (np.linalg.norm(L[0]) if scale is None else scale)
+
+
 def deck_variant(src, dst, **changes):
     """Copy a deck, replacing `key = value` assignments (first occurrence of each key) and
     making relative mesh paths absolute so the copy can live elsewhere."""

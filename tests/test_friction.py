@@ -59,7 +59,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, history, momentum_error, run, run_scene
+from casca_testlib import Checks, angular_drift, history, momentum_error, run, run_scene
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
 os.makedirs(work, exist_ok=True)
@@ -219,8 +219,7 @@ for dt in (2e-5, 1e-5):
     ck.record("rattle %g s: the ball touches the shell and slides (friction work > 0)" % dt,
               h["contacts"].max() > 0 and h["friction_work"][-1] > 0)
     ck.le("rattle %g s: linear momentum kept, max |p - p0| / |p0|" % dt, momentum_error(h), 1e-9)
-    L = np.stack([h["Lx"], h["Ly"], h["Lz"]]).T
-    drift[dt] = np.max(np.linalg.norm(L - L[0], axis=1)) / np.linalg.norm(L[0])
+    drift[dt] = angular_drift(h)
 if len(drift) == 2:
     ck.le("rattle: drift of L through friction at 20 us, max |L - L0| / |L0|", drift[2e-5], 1e-5)
     ck.le("rattle: drift of L at 10 us over drift at 20 us (%.2e, %.2e; second order 0.25)"

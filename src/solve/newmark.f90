@@ -71,7 +71,7 @@ contains
       contact%g_start = positions(model, st%q, fibres=.true.)   ! (friction's slip)
     end if
     released = [constraint_t ::]
-    call attempt()
+    call attempt(warm=.false.)
     if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
       if (present(contact)) then
         contact%nact = size(before); contact%act(1:size(before)) = before
@@ -90,8 +90,7 @@ contains
         call timer_stop(t_contact)
         if (allocated(err)) return
         iters = rep%iters
-        contact%nact = size(before); contact%act(1:size(before)) = before
-        call attempt()
+        call attempt(warm=.true.)
         if (allocated(err)) then   ! (the state is as it was: the step is cut)
           contact%nact = size(before); contact%act(1:size(before)) = before
           return
@@ -107,13 +106,17 @@ contains
     st%t = st%t + dt
     st%step = st%step + 1
   contains
-    !> the step from (st%q, st%qd, a0): q, qd, qdd
-    subroutine attempt()
+    !> the step from (st%q, st%qd, a0): q, qd, qdd. warm: Newton starts from the last
+    !> attempt's q and active set, which a0 changed by the released contacts' force alone
+    !> leaves close (from the predictor and the start's set again, a pressurised ball
+    !> flattening on a wall, whose contacts open every step, took each step twice over)
+    subroutine attempt(warm)
+      logical, intent(in) :: warm
       real(dp), allocatable :: qs(:)
       real(dp) :: cm
       allocate (qs(size(st%q)))
       call nm%inertia(st%q, st%qd, a0, cm, qs)
-      call nm%predictor(st%q, st%qd, a0, q)
+      if (.not. warm) call nm%predictor(st%q, st%qd, a0, q)
       where (model%fixed) q = st%q
       call newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, st%q, nm%alpha_f)
       if (.not. allocated(err) .and. .not. rep%converged) &
