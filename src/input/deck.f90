@@ -19,7 +19,7 @@ module casca_deck
   implicit none
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
-  public :: contact_cfg_t, obstacle_cfg_t, read_deck, add_problem, max_track, unset, deck_file
+  public :: contact_cfg_t, obstacle_cfg_t, read_deck, add_problem, max_track, unset, deck_file, default_newton_tol
 
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
@@ -30,6 +30,7 @@ module casca_deck
   integer, parameter :: long = 1024
   integer, parameter :: max_line_len = 4096
   real(dp), parameter :: unset = -huge(1._dp)   !< marks a value the deck did not give
+  real(dp), parameter :: default_newton_tol = 1e-9_dp   !< &run newton_tol when neither it nor tolerance is given
   character(len=*), parameter :: known_groups(8) = &
     [character(len=9) :: 'run', 'output', 'body', 'restraint', 'load', 'contact', 'obstacle', 'end']
 
@@ -41,7 +42,7 @@ module casca_deck
     real(dp) :: rho_inf = unset                 !< given: generalized-alpha (not beta, gamma)
     real(dp) :: tolerance = unset               !< given: steps chosen by the local error
     real(dp) :: tolerance_length = unset        !< what tolerance is relative to (scene size)
-    real(dp) :: newton_tol = 1e-9_dp
+    real(dp) :: newton_tol = unset              !< not given: default_newton_tol, or from tolerance
     integer :: newton_max_iter = 20
     integer :: load_steps = 10
     integer :: max_step_cuts = 4

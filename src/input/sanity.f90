@@ -59,7 +59,7 @@ contains
         call add_problem(deck, l, '&run: analysis must be ''dynamic'' or ''static'' (got '''// &
                          trim(r%analysis)//''')')
       end select
-      call positive(l, '&run: newton_tol', r%newton_tol)
+      if (r%newton_tol /= unset) call positive(l, '&run: newton_tol', r%newton_tol)
       call finite(l, '&run: gravity', r%gravity)
       if (r%newton_max_iter < 1 .or. r%newton_max_iter > max_newton_iter) call add_problem(deck, &
         l, '&run: newton_max_iter must be in 1..'//itoa(max_newton_iter)//' (got '// &
