@@ -224,7 +224,9 @@ contains
       if (failed(r, 'setup')) return
       if (deck%run%ordering == 'metis') r%ls%solver%ordering = 1
       r%ls%solver%single = deck%run%factor_precision == 'single'   ! (K only: M stays double)
-      r%opts%tol = newton_tolerance(deck, model%length); r%opts%max_iter = deck%run%newton_max_iter
+      r%opts%tol = default_newton_tol   ! (with a tolerance on the steps: dynamic_start)
+      if (deck%run%newton_tol /= unset) r%opts%tol = deck%run%newton_tol
+      r%opts%max_iter = deck%run%newton_max_iter
       r%opts%reuse = deck%run%reuse_factorisation
       allocate (r%fext(model%ndof))
       call gravity_load(model, r%fext)
@@ -398,6 +400,11 @@ contains
         ! and a step at the shortest that was still judged too long was taken again for ever:
         ! two balls glancing with skip_idle_bodies = .false. hung at 2.7875 ms)
         r%sc%dt_min = dt/2**deck%run%max_step_cuts*(1 + 1e-9_dp)
+        ! Newton's error, when the deck leaves it, a thousandth of the step's (within the
+        ! default 1e-9 and 1e-6): finer digits the steps lose (a fifth of the iterations on
+        ! the oblique rings; 1e-5 upset the energy watch: docs/performance.md)
+        if (deck%run%newton_tol == unset) r%opts%tol = &
+          min(1e-6_dp, max(default_newton_tol, 1e-3_dp*r%sc%tol*(r%sc%length/model%length)))
         if (r%dt_try == 0) r%dt_try = dt
       end if
       interval = deck%output%interval
@@ -650,27 +657,6 @@ contains
 
   !> The deck's contact (none: r%contact stays unallocated); K is block diagonal by body
   !> unless the constraints are factorised with it ('saddle', and 'auto' in statics)
-  !> Newton's tolerance relative to the scene size: the deck's newton_tol, else with a
-  !> tolerance on the steps a thousandth of it (within the default 1e-9 and 1e-6), else the
-  !> default. Newton converged to 1e-9 under steps allowed 1e-4 spent a fifth of its
-  !> iterations on digits the steps then lose (oblique rings at tolerance 1e-4 and 1e-5, 904
-  !> and 3,469 iterations to 707 and 2,680, x(t) the same within 3%); 1e-5 let a step's energy
-  !> balance drift past what the energy watch allows (docs/performance.md)
-  real(dp) function newton_tolerance(deck, length) result(tol)
-    type(deck_t), intent(in) :: deck
-    real(dp), intent(in) :: length   !< the scene's size
-    associate (run => deck%run)
-      tol = default_newton_tol
-      if (run%newton_tol /= unset) then
-        tol = run%newton_tol
-      else if (run%tolerance /= unset .and. run%analysis == 'dynamic') then
-        tol = 1e-3_dp*run%tolerance
-        if (run%tolerance_length /= unset) tol = tol*run%tolerance_length/length
-        tol = min(1e-6_dp, max(default_newton_tol, tol))
-      end if
-    end associate
-  end function newton_tolerance
-
   subroutine setup_contact(r)
     type(run_t), intent(inout) :: r
     logical :: use_contact
