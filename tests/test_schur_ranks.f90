@@ -1,0 +1,116 @@
+!> The Schur path with K dealt to groups of ranks (run on 2 ranks: one ring each, every rank
+!> holding only its own equations' entries of a row; on 1 rank: one block), on two rings
+!> that overlap obliquely, with force columns B that differ from the constraint rows C on
+!> ring 1's equations only, as generalized-alpha's force point makes them (B's entries
+!> there scaled by 1 + 0.02 sin e):
+!>   - the increment solves [K B^T; C 0] [x; dl] = [b; -gap]: |K x + B^T dl - b| within 1e-10
+!>     of max(|b|, |K x|, |B^T dl|) on every rank's equations, and |C x + gap| within 1e-10
+!>     of |gap| (C x summed over the ranks);
+!>   - the rows do differ (B /= C somewhere), and on 2 ranks ring 2's rank sees B = C in its
+!>     own entries: the case where a rank-local test of the symmetry of S = C K^-1 B^T gave
+!>     that rank other multipliers (two balls glancing on 2 ranks kept the momentum to
+!>     2.7e-9 instead of 6e-14).
+program test_schur_ranks
+  use casca_kinds, only: dp
+  use casca_error, only: error_t
+  use casca_model, only: model_t, reference_state
+  use casca_assembly, only: assembly_t, assembly_setup, assemble, nblocks
+  use casca_contact, only: contact_t, contact_init
+  use casca_contact_active_set, only: contact_update
+  use casca_contact_rows, only: contact_rows
+  use casca_obstacle, only: obstacle_t
+  use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, kkt_solve
+  use casca_mpi, only: mpi_start, mpi_stop, my_rank, n_ranks, sum_all
+  use casca_test_rings, only: overlapping_rings
+  use casca_check, only: check_le, check_true, check_summary
+  implicit none
+
+  type(model_t) :: model
+  type(assembly_t) :: asm
+  type(contact_t) :: c
+  type(linear_system_t) :: ls
+  type(rows_t) :: rows
+  type(error_t), allocatable :: err
+  real(dp), allocatable :: q(:), r(:), b(:), x(:), kx(:), btl(:), g(:)
+  integer, allocatable :: body_of(:)
+  real(dp) :: energy
+  integer :: i, e, k, n, nc, added, analyses, differ
+  real(dp) :: differ_here(2)   !< entries B /= C seen by rank 0, by the others
+
+  call mpi_start()
+  call overlapping_rings(model)
+  call assembly_setup(model, asm, err, split=.true.)
+  if (allocated(err)) error stop 'assembly'
+  call check_true('the rings are dealt one to a rank (2 ranks) or kept in one block (1 rank)', &
+                  asm%ngroups == n_ranks)
+  allocate (q(model%ndof), r(model%ndof))
+  call reference_state(model, q)
+  call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
+  call contact_update(c, model, q, .true., added)
+  call contact_rows(c, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, rows%key, rows%fval)
+  n = asm%neq; nc = size(rows%gap)
+  call check_true('overlapping rings: at least 4 constraints', nc >= 4)
+
+  ! B /= C on ring 1's equations only
+  allocate (body_of(n))
+  do i = 1, model%ndof
+    if (asm%eq(i) > 0) body_of(asm%eq(i)) = model%node_body((i - 1)/7 + 1)
+  end do
+  differ_here = 0
+  do e = 1, size(rows%irn)
+    if (rows%irn(e) == rows%jcn(e)) cycle
+    if (body_of(rows%jcn(e)) == 1) rows%fval(e) = rows%val(e)*(1 + 0.02_dp*sin(real(e, dp)))
+  end do
+  differ = count(rows%fval /= rows%val)
+  differ_here(min(my_rank, 1) + 1) = real(differ, dp)
+  call sum_all(differ); call sum_all(differ_here)
+  call check_true('B differs from C in some entries', differ > 0)
+  if (n_ranks == 2) call check_true("2 ranks: ring 2's rank sees B = C in its own entries", &
+                                    differ_here(1) > 0 .and. differ_here(2) == 0)
+
+  call assemble(model, asm, q, .true., r, energy, 4e8_dp, q)   ! cm = 1/(beta dt^2), dt 50 us
+  analyses = 0
+  call analyse_blocks(ls, model, asm, rows, analyses, err)
+  if (allocated(err)) error stop 'analysis'
+  call factorise_blocks(ls, asm, rows, err)
+  if (allocated(err)) error stop 'factorisation'
+  b = [([(1e3_dp*sin(0.37_dp*(k + 7*my_rank)), k=1, n)]), -rows%gap]
+  allocate (x(n + nc))
+  call kkt_solve(ls, asm, rows, b, .false., x, err)
+  if (allocated(err)) error stop 'solve'
+
+  ! residuals from K's entries (this rank's blocks; each rank hosts its own) and the rows
+  allocate (kx(n), btl(n), g(nc))
+  kx = 0; btl = 0; g = 0
+  do k = 1, nblocks
+    do e = asm%blk(k)%first, asm%blk(k)%last
+      associate (ia => asm%irn(e) + asm%blk(k)%off, ja => asm%jcn(e) + asm%blk(k)%off)
+        kx(ia) = kx(ia) + asm%a(e)*x(ja)
+        if (ia /= ja) kx(ja) = kx(ja) + asm%a(e)*x(ia)
+      end associate
+    end do
+  end do
+  do e = 1, size(rows%irn)
+    if (rows%irn(e) == rows%jcn(e)) cycle
+    btl(rows%jcn(e)) = btl(rows%jcn(e)) + rows%fval(e)*x(rows%irn(e))
+    g(rows%irn(e) - n) = g(rows%irn(e) - n) + rows%val(e)*x(rows%jcn(e))
+  end do
+  call sum_all(g)
+  call check_le('|K x + B^T dl - b| / max(|b|, |K x|, |B^T dl|), the largest over the ranks', &
+                largest(maxval(abs(kx + btl - b(1:n)))/ &
+                        max(maxval(abs(b(1:n))), maxval(abs(kx)), maxval(abs(btl)))), 1e-10_dp)
+  call check_le('|C x + gap| / |gap|', maxval(abs(g + rows%gap))/maxval(abs(rows%gap)), 1e-10_dp)
+  call ls%finish()
+  call check_summary()
+  call mpi_stop()
+contains
+
+  !> the largest of the ranks' values
+  real(dp) function largest(v)
+    real(dp), intent(in) :: v
+    real(dp) :: all(n_ranks)
+    all = 0; all(my_rank + 1) = v
+    call sum_all(all)
+    largest = maxval(all)
+  end function largest
+end program test_schur_ranks
