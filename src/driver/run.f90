@@ -296,7 +296,7 @@ contains
         if (allocated(r%contact)) contact_before = r%contact
         call newmark_step(model, r%asm, r%ls, nm, r%fext, r%opts, st, rep, r%err, r%contact)
         if (allocated(r%err)) then
-          if (r%level < deck%run%max_step_cuts) then
+          if (may_cut()) then
             call cut_step(r%err%message)   ! (the state is unchanged)
             deallocate (r%err)
             cycle
@@ -327,7 +327,7 @@ contains
           end if
         end if
         if (guarded .and. .not. energy_cut .and. step_judged(r) .and. &
-            made > made_limit*energy_scale() .and. r%level < deck%run%max_step_cuts) then
+            made > made_limit*energy_scale() .and. may_cut()) then
           call undo_step()
           call cut_step('the step made '//ftoa(100*made/energy_scale())//'% of the energy the '// &
                         'bodies hold (a node deep into a target, or a mode the step cannot follow)')
@@ -357,6 +357,15 @@ contains
       if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
         merge(r%dt_try, r%deck%run%dt/2**r%level, r%sc%tol > 0), ': ', why
     end subroutine cut_step
+
+    !> the step may be halved again: at most max_step_cuts times in a row, and with the error
+    !> control not below its shortest step halved as often again (accepted slivers between
+    !> the cuts start the count anew: a ring crushed past what its mesh can fold cut its step
+    !> down to 1.5e-11 s, where the grid's count of steps overflowed)
+    logical function may_cut()
+      may_cut = r%level < r%deck%run%max_step_cuts
+      if (r%sc%tol > 0) may_cut = may_cut .and. r%nm%dt/2 >= r%sc%dt_min/2**r%deck%run%max_step_cuts
+    end function may_cut
 
     subroutine undo_step()
       r%st = st_before; r%bal = bal_before
@@ -552,7 +561,7 @@ contains
   !> checkpoints and the grid of step lengths
   pure real(dp) function next_multiple(t, h)
     real(dp), intent(in) :: t, h
-    next_multiple = (floor(t/h + 1e-6_dp) + 1)*h
+    next_multiple = (aint(t/h + 1e-6_dp) + 1)*h   ! (aint: t/h may pass huge(1), t >= 0)
   end function next_multiple
 
   !> With the error control: is the step just taken within the tolerance (or at the shortest
