@@ -1,15 +1,22 @@
 !> A scene the unit tests share: two thesis rings (R 1, width 0.2, 20 cubic triangles around,
 !> h 0.05, steel) that overlap obliquely by 0.1 m on a line 0.4 m from the axis, so that
-!> several impactor nodes of ring 1 are inside ring 2, off the line of centres.
+!> several impactor nodes of ring 1 are inside ring 2, off the line of centres; their contact
+!> rows and the dynamic tangent factorised, for the tests of the Schur path.
 module casca_test_rings
   use casca_kinds, only: dp
   use casca_error, only: error_t
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_ring
-  use casca_model, only: model_t, model_add_body, model_finalize
+  use casca_model, only: model_t, model_add_body, model_finalize, reference_state
+  use casca_assembly, only: assembly_t, assemble
+  use casca_contact, only: contact_t, contact_init
+  use casca_contact_active_set, only: contact_update
+  use casca_contact_rows, only: contact_rows
+  use casca_obstacle, only: obstacle_t
+  use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks
   implicit none
   private
-  public :: overlapping_rings
+  public :: overlapping_rings, ring_rows, factorised
 
 contains
 
@@ -27,4 +34,40 @@ contains
     call model_finalize(model, err)
     if (allocated(err)) error stop 'model'
   end subroutine overlapping_rings
+
+  !> q: the rings where they are; rows: ring 1's nodes on ring 2 there (mid-surfaces), in
+  !> asm's equations
+  subroutine ring_rows(model, asm, q, rows)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(in) :: asm
+    real(dp), allocatable, intent(out) :: q(:)
+    type(rows_t), intent(out) :: rows
+    type(contact_t) :: c
+    integer :: added
+    allocate (q(model%ndof))
+    call reference_state(model, q)
+    call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
+    call contact_update(c, model, q, .true., added)
+    call contact_rows(c, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, rows%key, rows%fval)
+  end subroutine ring_rows
+
+  !> ls: K + cm M at q analysed and factorised for the rows (cm = 4e8 = 1/(beta dt^2), dt 50 us)
+  subroutine factorised(model, asm, q, rows, ls)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    real(dp), intent(in) :: q(:)
+    type(rows_t), intent(in) :: rows
+    type(linear_system_t), intent(inout) :: ls
+    type(error_t), allocatable :: err
+    real(dp), allocatable :: r(:)
+    real(dp) :: energy
+    integer :: analyses
+    allocate (r(model%ndof))
+    call assemble(model, asm, q, .true., r, energy, 4e8_dp, q)
+    analyses = 0
+    call analyse_blocks(ls, model, asm, rows, analyses, err)
+    if (allocated(err)) error stop 'analysis'
+    call factorise_blocks(ls, asm, rows, err)
+    if (allocated(err)) error stop 'factorisation'
+  end subroutine factorised
 end module casca_test_rings

@@ -15,44 +15,29 @@
 program test_schur
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_model, only: model_t, reference_state
-  use casca_assembly, only: assembly_t, assembly_setup, assemble
-  use casca_contact, only: contact_t, contact_init
-  use casca_contact_active_set, only: contact_update
-  use casca_contact_rows, only: contact_rows
-  use casca_obstacle, only: obstacle_t
-  use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, kkt_solve
+  use casca_model, only: model_t
+  use casca_assembly, only: assembly_t, assembly_setup
+  use casca_linear_system, only: linear_system_t, rows_t, factorise_blocks, kkt_solve
   use casca_solver_choice, only: solver_choice_t, choose_solver
   use casca_mpi, only: mpi_start, mpi_stop
-  use casca_test_rings, only: overlapping_rings
+  use casca_test_rings, only: overlapping_rings, ring_rows, factorised
   use casca_check, only: check_le, check_true, check_summary
   implicit none
 
   type(model_t) :: model
   type(assembly_t) :: asm
-  type(contact_t) :: c
   type(linear_system_t) :: ls
   type(rows_t) :: ra, rb, rold
   type(error_t), allocatable :: err
-  real(dp), allocatable :: q(:), r(:), b(:), x0(:), xs(:), xr(:), xf(:), xo(:)
-  real(dp) :: energy
-  integer :: i, nb, added, analyses, kept, made
+  real(dp), allocatable :: q(:), b(:), x0(:), xs(:), xr(:), xf(:), xo(:)
+  integer :: i, nb, kept, made
 
   call mpi_start()
   call overlapping_rings(model)
   call assembly_setup(model, asm, err)
-  allocate (q(model%ndof), r(model%ndof))
-  call reference_state(model, q)
-  call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
-  call contact_update(c, model, q, .true., added)
-  call contact_rows(c, model, asm%eq, asm%neq, ra%irn, ra%jcn, ra%val, ra%gap, ra%key, ra%fval)
+  call ring_rows(model, asm, q, ra)
   call check_true('overlapping rings: at least 4 constraints', size(ra%gap) >= 4)
-  call assemble(model, asm, q, .true., r, energy, 4e8_dp, q)   ! cm = 1/(beta dt^2), dt 50 us
-  analyses = 0
-  call analyse_blocks(ls, model, asm, ra, analyses, err)
-  if (allocated(err)) error stop 'analysis'
-  call factorise_blocks(ls, asm, ra, err)
-  if (allocated(err)) error stop 'factorisation'
+  call factorised(model, asm, q, ra, ls)
 
   ! a fresh Z for set A
   allocate (x0(asm%neq + size(ra%gap)))

@@ -13,28 +13,22 @@
 program test_schur_ranks
   use casca_kinds, only: dp
   use casca_error, only: error_t
-  use casca_model, only: model_t, reference_state
-  use casca_assembly, only: assembly_t, assembly_setup, assemble, nblocks
-  use casca_contact, only: contact_t, contact_init
-  use casca_contact_active_set, only: contact_update
-  use casca_contact_rows, only: contact_rows
-  use casca_obstacle, only: obstacle_t
-  use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, kkt_solve
+  use casca_model, only: model_t
+  use casca_assembly, only: assembly_t, assembly_setup, nblocks
+  use casca_linear_system, only: linear_system_t, rows_t, kkt_solve
   use casca_mpi, only: mpi_start, mpi_stop, my_rank, n_ranks, sum_all
-  use casca_test_rings, only: overlapping_rings
+  use casca_test_rings, only: overlapping_rings, ring_rows, factorised
   use casca_check, only: check_le, check_true, check_summary
   implicit none
 
   type(model_t) :: model
   type(assembly_t) :: asm
-  type(contact_t) :: c
   type(linear_system_t) :: ls
   type(rows_t) :: rows
   type(error_t), allocatable :: err
-  real(dp), allocatable :: q(:), r(:), b(:), x(:), kx(:), btl(:), g(:)
+  real(dp), allocatable :: q(:), b(:), x(:), kx(:), btl(:), g(:)
   integer, allocatable :: body_of(:)
-  real(dp) :: energy
-  integer :: i, e, k, n, nc, added, analyses, differ
+  integer :: i, e, k, n, nc, differ
   real(dp) :: differ_here(2)   !< entries B /= C seen by rank 0, by the others
 
   call mpi_start()
@@ -43,11 +37,7 @@ program test_schur_ranks
   if (allocated(err)) error stop 'assembly'
   call check_true('the rings are dealt one to a rank (2 ranks) or kept in one block (1 rank)', &
                   asm%ngroups == n_ranks)
-  allocate (q(model%ndof), r(model%ndof))
-  call reference_state(model, q)
-  call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
-  call contact_update(c, model, q, .true., added)
-  call contact_rows(c, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, rows%key, rows%fval)
+  call ring_rows(model, asm, q, rows)
   n = asm%neq; nc = size(rows%gap)
   call check_true('overlapping rings: at least 4 constraints', nc >= 4)
 
@@ -68,12 +58,7 @@ program test_schur_ranks
   if (n_ranks == 2) call check_true("2 ranks: ring 2's rank sees B = C in its own entries", &
                                     differ_here(1) > 0 .and. differ_here(2) == 0)
 
-  call assemble(model, asm, q, .true., r, energy, 4e8_dp, q)   ! cm = 1/(beta dt^2), dt 50 us
-  analyses = 0
-  call analyse_blocks(ls, model, asm, rows, analyses, err)
-  if (allocated(err)) error stop 'analysis'
-  call factorise_blocks(ls, asm, rows, err)
-  if (allocated(err)) error stop 'factorisation'
+  call factorised(model, asm, q, rows, ls)
   b = [([(1e3_dp*sin(0.37_dp*(k + 7*my_rank)), k=1, n)]), -rows%gap]
   allocate (x(n + nc))
   call kkt_solve(ls, asm, rows, b, .false., x, err)

@@ -228,8 +228,8 @@ contains
       '''); at '//itoa(nint(steps_per_period))//' steps per period dt follows vibrations up to '// &
       rtoa(1/(steps_per_period*dt))//' Hz, membrane waves go up to ~ '// &
       rtoa(f(b)%omega_m/(2*acos(-1._dp)))//' Hz, the thickness stretch to ~ '// &
-      rtoa(maxval(f%omega_t)/(2*acos(-1._dp)))//' Hz (the implicit step stays stable; Newmark '// &
-      'with gamma > 1/2 damps what it does not follow)'
+      rtoa(maxval(f%omega_t)/(2*acos(-1._dp)))//' Hz (the implicit step stays stable; '// &
+      damping()//')'
     if (deck%contact%stiffness == unset) return
     tc = contact_time(deck, model, b)
     write (u, '(a)') 'contact: stiffness '//rtoa(deck%contact%stiffness)//' Pa/m: a shell of this scene '// &
@@ -237,6 +237,19 @@ contains
       rtoa(tc)//' s (body '''//model%body(b)%name//'''), '// &
       rtoa(tc/dt)//' steps of dt (a plate''s bounce lost 1% of its '// &
       'energy over 16 steps of it, 3e-5 over 31: docs/method.md)'
+  contains
+    !> what the deck's scheme does with what the step does not follow
+    function damping() result(s)
+      character(len=:), allocatable :: s
+      if (deck%run%rho_inf /= unset) then
+        s = 'generalized-alpha damps what it does not follow, to rho_inf = '//rtoa(deck%run%rho_inf)// &
+            ' at the highest frequencies'
+      else if (deck%run%gamma > 0.5_dp) then
+        s = 'Newmark with gamma > 1/2 damps what it does not follow'
+      else
+        s = 'Newmark with gamma = 1/2 keeps what it does not follow, undamped'
+      end if
+    end function damping
   end subroutine step_line
 
   !> A compliant contact's time for its stiffest body, pi sqrt(rho h / stiffness) (a flat shell
