@@ -14,9 +14,10 @@ module casca_test_rings
   use casca_contact_rows, only: contact_rows
   use casca_obstacle, only: obstacle_t
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks
+  use casca_mpi, only: sum_all
   implicit none
   private
-  public :: overlapping_rings, ring_rows, factorised
+  public :: overlapping_rings, ring_rows, factorised, saddle_residuals
 
 contains
 
@@ -70,4 +71,36 @@ contains
     call factorise_blocks(ls, asm, rows, err)
     if (allocated(err)) error stop 'factorisation'
   end subroutine factorised
+
+  !> The saddle-point system's residuals at x = [dq; dl] for b = [f; -gap], from K's entries
+  !> (each of this rank's blocks) and the rows: force, |K dq + B^T dl - f| over
+  !> max(|f|, |K dq|, |B^T dl|) on this rank's equations; gap, |C dq + gap| / |gap| with C dq
+  !> summed over the ranks
+  subroutine saddle_residuals(asm, rows, b, x, force, gap)
+    type(assembly_t), intent(in) :: asm
+    type(rows_t), intent(in) :: rows
+    real(dp), intent(in) :: b(:), x(:)
+    real(dp), intent(out) :: force, gap
+    real(dp), allocatable :: kx(:), btl(:), g(:)
+    integer :: e, k, n
+    n = asm%neq
+    allocate (kx(n), btl(n), g(size(rows%gap)))
+    kx = 0; btl = 0; g = 0
+    do k = 1, size(asm%blk)
+      do e = asm%blk(k)%first, asm%blk(k)%last
+        associate (ia => asm%irn(e) + asm%blk(k)%off, ja => asm%jcn(e) + asm%blk(k)%off)
+          kx(ia) = kx(ia) + asm%a(e)*x(ja)
+          if (ia /= ja) kx(ja) = kx(ja) + asm%a(e)*x(ia)
+        end associate
+      end do
+    end do
+    do e = 1, size(rows%irn)
+      if (rows%irn(e) == rows%jcn(e)) cycle
+      btl(rows%jcn(e)) = btl(rows%jcn(e)) + rows%fval(e)*x(rows%irn(e))
+      g(rows%irn(e) - n) = g(rows%irn(e) - n) + rows%val(e)*x(rows%jcn(e))
+    end do
+    call sum_all(g)
+    force = maxval(abs(kx + btl - b(1:n)))/max(maxval(abs(b(1:n))), maxval(abs(kx)), maxval(abs(btl)))
+    gap = maxval(abs(g + rows%gap))/maxval(abs(rows%gap))
+  end subroutine saddle_residuals
 end module casca_test_rings
