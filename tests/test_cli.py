@@ -18,7 +18,8 @@ Asserted about the command line itself (issue 17):
   with no "empty y range" in their stdout or stderr, and the warning is in the folder's
   gnuplot.log instead (so the scene does provoke it).
 - a misspelt body name (in &restraint, in &contact pairs) or key is named with the nearest
-  one: "(did you mean 'ring2'?)", "(did you mean 'tolerance'?)".
+  one: "(did you mean 'ring2'?)", "(did you mean 'tolerance'?)"; a key of another group with
+  that group: a body's pressure, "(a key of &load)".
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -179,6 +180,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("misspelt body in the pairs", lambda s: s + "&contact\n pairs = 'ring1', 'rings2'\n/\n",
      ["pairs(:, 1)", "rings2", "did you mean 'ring2'?"]),
     ("misspelt key in &contact", lambda s: s + "&contact\n tolerence = 1e-6\n/\n", ["&contact", "tolerence", "did you mean 'tolerance'?"]),
+    ("a key of another group", lambda s: s.replace("young = 210e9, ", "young = 210e9, pressure = 1e3, ", 1),
+     ["&body", "unknown key 'pressure'", "(a key of &load)"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),

@@ -230,12 +230,28 @@ contains
     end do
   end function group_ends
 
-  !> ' (did you mean ''x''?)' for the nearest key of the group (of any group if none is near)
+  !> ' (did you mean ''x''?)' for the nearest key of the group; a key of other groups named
+  !> as theirs (a body's pressure was met with "did you mean 'pressure'?"); else the nearest
+  !> key of any group
   function suggestion(group, key) result(s)
     character(len=*), intent(in) :: group, key
     character(len=:), allocatable :: s
+    integer :: k
     s = did_you_mean(key, pack(keys%name, keys%group == group))
-    if (s == '') s = did_you_mean(key, keys%name)
+    if (s /= '') return
+    do k = 1, size(keys)
+      if (keys(k)%name /= key) cycle
+      if (s == '') then
+        s = ' (a key of &'//trim(keys(k)%group)
+      else
+        s = s//' and &'//trim(keys(k)%group)
+      end if
+    end do
+    if (s /= '') then
+      s = s//')'
+    else
+      s = did_you_mean(key, keys%name)
+    end if
   end function suggestion
 
   !> ' (did you mean ''x''?)' for the candidate nearest to name by edit distance (at most 2
