@@ -154,7 +154,7 @@ contains
     c%current = .true.
     ! each rank holds only its equations' entries of a row, so whether B differs from C is
     ! pooled: a rank that saw none took S as symmetric and solved for other multipliers than
-    ! the rest (two balls glancing on 2 ranks kept the momentum to 2.7e-9 only, now 5e-14)
+    ! the rest (two balls glancing on 2 ranks kept the momentum to 2.7e-9 only, now 6e-14)
     m = count(c%fval /= c%val)
     call sum_all(m)
     call factorise_s(c, m > 0, err)
