@@ -14,7 +14,7 @@ module casca_test_rings
   use casca_contact_rows, only: contact_rows
   use casca_obstacle, only: obstacle_t
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks
-  use casca_mpi, only: sum_all
+  use casca_mpi, only: sum_all, max_all
   implicit none
   private
   public :: overlapping_rings, ring_rows, factorised, saddle_residuals
@@ -74,8 +74,8 @@ contains
 
   !> The saddle-point system's residuals at x = [dq; dl] for b = [f; -gap], from K's entries
   !> (each of this rank's blocks) and the rows: force, |K dq + B^T dl - f| over
-  !> max(|f|, |K dq|, |B^T dl|) on this rank's equations; gap, |C dq + gap| / |gap| with C dq
-  !> summed over the ranks
+  !> max(|f|, |K dq|, |B^T dl|) on each rank's equations, the largest over the ranks; gap,
+  !> |C dq + gap| / |gap| with C dq summed over the ranks
   subroutine saddle_residuals(asm, rows, b, x, force, gap)
     type(assembly_t), intent(in) :: asm
     type(rows_t), intent(in) :: rows
@@ -101,6 +101,7 @@ contains
     end do
     call sum_all(g)
     force = maxval(abs(kx + btl - b(1:n)))/max(maxval(abs(b(1:n))), maxval(abs(kx)), maxval(abs(btl)))
+    call max_all(force)
     gap = maxval(abs(g + rows%gap))/maxval(abs(rows%gap))
   end subroutine saddle_residuals
 end module casca_test_rings

@@ -1,7 +1,7 @@
 !> The only place MPI is set up: rank, size, the group communicators of the linear solver,
 !> and the few collectives casca uses.
 module casca_mpi
-  use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_SUM, &
+  use mpi_f08, only: MPI_Comm, MPI_Op, MPI_COMM_WORLD, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_SUM, &
                      MPI_MIN, MPI_MAX, MPI_CHARACTER, mpi_init, mpi_finalize, mpi_comm_rank, &
                      mpi_comm_size, mpi_initialized, mpi_finalized, mpi_wtime, mpi_allreduce, &
                      mpi_bcast, mpi_comm_split, mpi_comm_free, mpi_get_library_version, &
@@ -23,6 +23,10 @@ module casca_mpi
   interface sum_all
     module procedure sum_all_r2, sum_all_r1, sum_all_r0, sum_all_i0
   end interface sum_all
+
+  interface max_all
+    module procedure max_all_i0, max_all_r0
+  end interface max_all
 
   interface bcast_real
     module procedure bcast_r1, bcast_r0
@@ -150,31 +154,45 @@ contains
   end subroutine sum_all_r2
 
   !> The largest x of all ranks, on every rank (the exit code: all ranks end with the same).
-  subroutine max_all(x)
+  subroutine max_all_i0(x)
     integer, intent(inout) :: x
-    integer :: y(1), ierr
-    if (n_ranks == 1) return
-    call mpi_allreduce([x], y, 1, MPI_INTEGER, MPI_MAX, comm, ierr)
-    x = y(1)
-  end subroutine max_all
+    call reduce_i0(x, MPI_MAX)
+  end subroutine max_all_i0
+
+  subroutine max_all_r0(x)
+    real(dp), intent(inout) :: x
+    call reduce_r0(x, MPI_MAX)
+  end subroutine max_all_r0
 
   subroutine sum_all_i0(x)
     integer, intent(inout) :: x
-    integer :: y(1)
-    integer :: ierr
-    if (n_ranks == 1) return
-    call mpi_allreduce([x], y, 1, MPI_INTEGER, MPI_SUM, comm, ierr)
-    x = y(1)
+    call reduce_i0(x, MPI_SUM)
   end subroutine sum_all_i0
 
   subroutine sum_all_r0(x)
     real(dp), intent(inout) :: x
+    call reduce_r0(x, MPI_SUM)
+  end subroutine sum_all_r0
+
+  !> x combined by op over all ranks, on every rank
+  subroutine reduce_i0(x, op)
+    integer, intent(inout) :: x
+    type(MPI_Op), intent(in) :: op
+    integer :: y(1), ierr
+    if (n_ranks == 1) return
+    call mpi_allreduce([x], y, 1, MPI_INTEGER, op, comm, ierr)
+    x = y(1)
+  end subroutine reduce_i0
+
+  subroutine reduce_r0(x, op)
+    real(dp), intent(inout) :: x
+    type(MPI_Op), intent(in) :: op
     real(dp) :: y(1)
     integer :: ierr
     if (n_ranks == 1) return
-    call mpi_allreduce([x], y, 1, MPI_DOUBLE_PRECISION, MPI_SUM, comm, ierr)
+    call mpi_allreduce([x], y, 1, MPI_DOUBLE_PRECISION, op, comm, ierr)
     x = y(1)
-  end subroutine sum_all_r0
+  end subroutine reduce_r0
 
 
 

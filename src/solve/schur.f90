@@ -128,6 +128,7 @@ contains
     real(dp), allocatable :: z(:, :), cz(:, :), v(:), fv(:)
     integer, allocatable :: first(:)
     integer :: nc, k, i, m, n, a, b
+    integer :: unsym   !< entries where B differs from C, over the ranks
     nc = size(key, 2)
     allocate (z(neq, nc), cz(nc, nc))
     v = val; fv = fval
@@ -155,9 +156,9 @@ contains
     ! each rank holds only its equations' entries of a row, so whether B differs from C is
     ! pooled: a rank that saw none took S as symmetric and solved for other multipliers than
     ! the rest (two balls glancing on 2 ranks kept the momentum to 2.7e-9 only, now 6e-14)
-    m = count(c%fval /= c%val)
-    call sum_all(m)
-    call factorise_s(c, m > 0, err)
+    unsym = count(c%fval /= c%val)
+    call sum_all(unsym)
+    call factorise_s(c, unsym > 0, err)
   end subroutine schur_store
 
   !> The entries of S = C Z (this rank's part) whose row or column is new (col = 0)
