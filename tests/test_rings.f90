@@ -7,7 +7,7 @@ module casca_test_rings
   use casca_error, only: error_t
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_ring
-  use casca_model, only: model_t, model_add_body, model_finalize, reference_state
+  use casca_model, only: model_t, model_add_body, model_finalize, reference_state, dof
   use casca_assembly, only: assembly_t, assemble
   use casca_contact, only: contact_t, contact_init
   use casca_contact_active_set, only: contact_update
@@ -36,17 +36,25 @@ contains
     if (allocated(err)) error stop 'model'
   end subroutine overlapping_rings
 
-  !> q: the rings where they are; rows: ring 1's nodes on ring 2 there (mid-surfaces), in
+  !> q: the rings where they are (turned by the rotation turn about the origin, if given: the
+  !> nodes' positions and fibres); rows: ring 1's nodes on ring 2 there (mid-surfaces), in
   !> asm's equations
-  subroutine ring_rows(model, asm, q, rows)
+  subroutine ring_rows(model, asm, q, rows, turn)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(in) :: asm
     real(dp), allocatable, intent(out) :: q(:)
     type(rows_t), intent(out) :: rows
+    real(dp), intent(in), optional :: turn(3, 3)
     type(contact_t) :: c
-    integer :: added
+    integer :: added, n
     allocate (q(model%ndof))
     call reference_state(model, q)
+    if (present(turn)) then
+      do n = 1, model%nnode
+        q(dof(n, 1):dof(n, 3)) = matmul(turn, q(dof(n, 1):dof(n, 3)))
+        q(dof(n, 4):dof(n, 6)) = matmul(turn, q(dof(n, 4):dof(n, 6)))
+      end do
+    end if
     call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
     call contact_update(c, model, q, .true., added)
     call contact_rows(c, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, rows%key, rows%fval)
@@ -68,7 +76,7 @@ contains
     analyses = 0
     call analyse_blocks(ls, model, asm, rows, analyses, err)
     if (allocated(err)) error stop 'analysis'
-    call factorise_blocks(ls, asm, rows, err)
+    call factorise_blocks(ls, model, asm, rows, q, err)
     if (allocated(err)) error stop 'factorisation'
   end subroutine factorised
 

@@ -83,7 +83,7 @@ program test_schur
   call kkt_solve(ls, asm, rb, b, .false., xr, err)
   call check_true('the same rows again: every column kept, none made', &
                   ls%cache%made == made .and. ls%cache%kept == kept)
-  call factorise_blocks(ls, asm, rb, err)
+  call factorise_blocks(ls, model, asm, rb, q, err)
   call kkt_solve(ls, asm, rb, b, .false., xr, err)
   call check_true('K factorised again: every column made', ls%cache%made - made == nb)
   call ls%finish()

@@ -18,11 +18,12 @@ module casca_linear_system
   use casca_mass_solver, only: mass_solver_t
   use casca_contact_correction, only: correction_cache_t
   use casca_metis, only: nested_dissection
+  use casca_body_frames, only: body_frames_t, frames_keep, frames_follow, frames_turn
   use casca_mpi, only: sum_all, share_error
   implicit none
   private
   public :: linear_system_t, rows_t, analyse_blocks, factorise_blocks, solve_blocks, kkt_solve, &
-            negative_pivots
+            negative_pivots, follow_bodies
 
   !> Constraint rows in MUMPS's coordinates: entries (neq + k, eq) of dg_k/dq, a zero
   !> diagonal (neq + k, neq + k) per multiplier, and the gaps; key(2, k): the (node, element)
@@ -45,6 +46,7 @@ module casca_linear_system
                                                !< because the pattern was analysed anew
     logical :: analysed = .false.              !< analysed in this iteration
     type(schur_t) :: cache                     !< Z and S of the Schur path
+    type(body_frames_t) :: frames              !< the bodies' turn since K was factorised
     integer, allocatable :: last_irn(:), last_jcn(:)   !< constraint pattern last analysed
     type(mass_solver_t) :: mass                !< M by component, for the contact correction
     type(correction_cache_t) :: correction     !< its last C M^-1 C^T, factorised
@@ -123,10 +125,12 @@ contains
 
   !> Numerical factorisation of every block (with 'saddle', block 1 holds the rows' values).
   !> The blocks factorise apart: all go on, or none.
-  subroutine factorise_blocks(ls, asm, rows, err)
+  subroutine factorise_blocks(ls, model, asm, rows, q, err)
     type(linear_system_t), intent(inout) :: ls
+    type(model_t), intent(in) :: model
     type(assembly_t), intent(in) :: asm
     type(rows_t), intent(in) :: rows
+    real(dp), intent(in) :: q(:)   !< where K was assembled
     type(error_t), allocatable, intent(out) :: err
     type(error_t), allocatable :: e
     integer :: s
@@ -142,6 +146,7 @@ contains
       if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
     end do
     call share_error(err)
+    call frames_keep(ls%frames, model, asm%eq, q)
     ls%cache%current = .false.   ! Z was made with the old factors
     ls%refactored = .not. ls%analysed   ! (a new pattern's factorisation is the analysis' cost)
   end subroutine factorise_blocks
@@ -158,17 +163,31 @@ contains
     integer, intent(in) :: extra
     type(error_t), allocatable, intent(out) :: err
     type(error_t), allocatable :: e
+    real(dp), allocatable :: bt(:, :)
     integer :: lo, hi, s
     xx = 0
+    bt = bb
+    if (ls%schur) call frames_turn(ls%frames, bt, back=.true.)   ! (saddle: C is in its factors)
     do s = 1, nblocks
       if (asm%blk(s)%neq == 0) cycle
       lo = asm%blk(s)%off + 1
       hi = asm%blk(s)%off + asm%blk(s)%neq + merge(extra, 0, s == 1)
-      call ls%solver(s)%solve(bb(lo:hi, :), xx(lo:hi, :), e)
+      call ls%solver(s)%solve(bt(lo:hi, :), xx(lo:hi, :), e)
       if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
     end do
     call share_error(err)
+    if (ls%schur) call frames_turn(ls%frames, xx, back=.false.)
   end subroutine solve_blocks
+
+  !> With kept factors on the Schur path: solve in the frames the free bodies have turned to
+  !> since (casca_body_frames); Z made in the old frames is made again.
+  subroutine follow_bodies(ls, model, q)
+    type(linear_system_t), intent(inout) :: ls
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    if (.not. ls%schur) return
+    if (frames_follow(ls%frames, model, q)) ls%cache%current = .false.
+  end subroutine follow_bodies
 
   !> The saddle-point solve: b (asm%neq + nc) holds K's right-hand side then -gap; x the
   !> increment of this rank's equations then dlambda (replicated with 'schur'; on the host

@@ -27,7 +27,7 @@ module casca_newton
   use casca_assembly, only: assembly_t, assemble
   use casca_pressure_assembly, only: add_pressure   ! follower pressure (issue 17)
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
-                                 kkt_solve, negative_pivots
+                                 kkt_solve, negative_pivots, follow_bodies
   use casca_contact, only: contact_t, constraint_t
   use casca_contact_active_set, only: contact_update, contact_settle, contact_solve_start
   use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_nrows, &
@@ -148,10 +148,12 @@ contains
       end if
       if (fresh) then
         call timer_start(t_factor)
-        call factorise_blocks(ls, asm, rows, err)
+        call factorise_blocks(ls, model, asm, rows, q, err)
         call timer_stop(t_factor)
         if (allocated(err)) exit
         rep%factorisations = rep%factorisations + 1
+      else
+        call follow_bodies(ls, model, q)
       end if
       call take_increment()
       if (allocated(err)) exit

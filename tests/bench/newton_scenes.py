@@ -12,6 +12,12 @@ pile       three steel tubes (R 50 mm, h 2 mm) dropped as a pyramid at 3 m/s ont
 spin       a ring spinning at 10 rad/s while it flies at 10 m/s, generalized-alpha 0.8, dt
            1.25 ms, 0.3 s (no contact: the predictor alone)
 rings      the thesis' two rings (examples/two_rings.nml's scene, its Newmark beta 1)
+tumble     an aluminium plate (0.3 x 0.2 m, h 1 mm, 6 x 4 cells) flying at 2 m/s and tumbling at
+           (0.5, 30, 0.3) rad/s, tolerance 1e-4, 0.1 s (no contact: kept factors on a turning body)
+bowl       a steel ball (R 50 mm, h 1 mm, n_div 3) thrown spinning at 30 rad/s inside a rough
+           rigid spherical bowl (friction 0.3), gravity, tolerance 1e-4, 20 ms
+tube       a steel tube (R 50 mm, 0.3 m long, h 2 mm, 16 x 4 cells) spinning at 30 rad/s, thrown
+           onto a plane tilted 0.1 rad, friction 0.3, gravity, tolerance 1e-4, 40 ms
 
 usage: python3 tests/bench/newton_scenes.py OLD_CASCA NEW_CASCA WORK [--only a,b] [--long]
 """
@@ -60,6 +66,24 @@ decks = {
     "spin": f"""&run rho_inf = 0.8, dt = 1.25e-3, t_end = 0.3 /
 {OUT.format(iv=0.01)}&body name = 'ring', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0,
   omega = 0.0, 0.0, 10.0, young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05 /
+""",
+    "tumble": f"""&run dt = 1e-4, t_end = 0.1, tolerance = 1e-4 /
+{OUT.format(iv=5e-3)}&body name = 'plate', mesh = 'plate', lx = 0.3, ly = 0.2, nx = 6, ny = 4,
+  velocity = 2.0, 0.0, 0.0, omega = 0.5, 30.0, 0.3, {ALU}, thickness = 0.001 /
+""",
+    "bowl": f"""&run dt = 1e-4, t_end = 0.02, tolerance = 1e-4, gravity = 0.0, 0.0, -9.81 /
+{OUT.format(iv=2e-3)}&body name = 'ball', mesh = 'sphere', radius = 0.05, n_div = 3, center = 0.0, 0.0, -0.1,
+  velocity = 4.0, 1.0, -2.0, omega = 0.0, 30.0, 0.0, young = 200e9, poisson = 0.3, density = 7800,
+  thickness = 0.001 /
+&obstacle name = 'bowl', shape = 'sphere', point = 0.0, 0.0, 0.0, radius = 0.2, inside = .true.,
+  friction = 0.3 /
+""",
+    "tube": f"""&run dt = 1e-4, t_end = 0.04, tolerance = 1e-4, gravity = 0.0, 0.0, -9.81 /
+{OUT.format(iv=2e-3)}&body name = 'tube', mesh = 'ring', radius = 0.05, width = 0.3, n_around = 16, n_across = 4,
+  rotate_axis = 0.0, 1.0, 0.0, rotate_angle = 80.0, center = 0.0, 0.0, 0.2,
+  velocity = 1.0, 0.0, -4.0, omega = 0.0, 0.0, 30.0, {STEEL}, thickness = 0.002 /
+&obstacle name = 'slope', shape = 'plane', point = 0.0, 0.0, 0.0, normal = -0.0998, 0.0, 0.995,
+  friction = 0.3 /
 """,
     "rings": f"""&run dt = 5.0e-5, t_end = 0.04, beta = 1.0, gamma = 1.5 /
 {OUT.format(iv=1e-3)}&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0,
