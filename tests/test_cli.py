@@ -157,6 +157,16 @@ with open(flat_msh, "w") as f:    # one element whose 10 nodes lie on a line: de
     f.write("".join("%g 0 0\n" % (0.1 * i) for i in range(10)))
     f.write("$EndNodes\n$Elements\n1 1 1 1\n2 1 21 1\n1 1 2 3 4 5 6 7 8 9 10\n$EndElements\n")
 
+mixed_msh = os.path.join(work, "mixed.msh")
+with open(mixed_msh, "w") as f:   # one 10-node triangle and one 4-node quadrangle: half the shell
+    f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 11 1 11\n2 1 0 11\n")
+    f.write("".join("%d\n" % i for i in range(1, 12)))
+    xy = [(0, 0), (1, 0), (0, 1), (1 / 3, 0), (2 / 3, 0), (2 / 3, 1 / 3), (1 / 3, 2 / 3), (0, 2 / 3),
+          (0, 1 / 3), (1 / 3, 1 / 3), (1, 1)]
+    f.write("".join("%.17g %.17g 0\n" % p for p in xy))
+    f.write("$EndNodes\n$Elements\n2 2 1 2\n2 1 21 1\n1 1 2 3 4 5 6 7 8 9 10\n"
+            "2 1 3 1\n2 2 11 3 3\n$EndElements\n")
+
 cases = [  # (name, text transformation, substrings the message must hold)
     ("missing deck file", None, ["no_such_deck.nml", "cannot open"]),
     ("unknown group", lambda s: s.replace("&output", "&outptu"), ["&outptu", ":4:"]),
@@ -170,6 +180,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("missing mesh file", lambda s: s.replace(ring, "/no/such/ring.msh", 1), ["/no/such/ring.msh", "does not exist"]),
     ("empty mesh", lambda s: s.replace(ring, empty_msh, 1), ["empty.msh", "10-node triangles"]),
     ("degenerate element", lambda s: s.replace(ring, flat_msh, 1), ["degenerate", "ring1"]),
+    ("quadrangles beside the triangles", lambda s: s.replace(ring, mixed_msh, 1),
+     ["mixed.msh", "1 surface element that is not a 10-node triangle", "Gmsh type 3, line 35"]),
     ("restraint selects no node", lambda s: s + "&restraint\n body = 'ring2', box_min = 50.0, 50.0, 50.0, fix = 'y'\n/\n",
      ["&restraint", "no node", "ring2"]),
     ("node set out of range", lambda s: s + "&restraint\n body = 'ring2', nodes = 1, 2, 999, fix = 'y'\n/\n",
@@ -183,6 +195,9 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("a key of another group", lambda s: s.replace("young = 210e9, ", "young = 210e9, pressure = 1e3, ", 1),
      ["&body", "unknown key 'pressure'", "(a key of &load)"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
+    ("a byte-order mark", lambda s: "\ufeff" + s, ["byte-order mark", ":1:"]),
+    ("names making one history column", lambda s: s.replace("'ring1'", "'ring 1'").replace("'ring2'", "'ring_1'"),
+     ["name 'ring_1' and 'ring 1' make the same history column name 'ring_1'", ":14:"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),
     ("missing required value", lambda s: s.replace("young = 210e9, ", "", 1), ["young", "missing"]),
@@ -194,7 +209,7 @@ for name, change, needles in cases:
     if change is None:
         deck = os.path.join(work, "no_such_deck.nml")
     else:
-        with open(deck, "w") as f:
+        with open(deck, "w", encoding="utf-8") as f:
             f.write(change(good))
     p = run([casca, "run", deck, "--out", os.path.join(work, "bad_out")])
     msg = p.stderr

@@ -160,6 +160,16 @@ if restart_into("moved", "restart into a new folder", new_out):
     ck.record("restart into a new folder: the checkpoint's folder keeps its history",
               open(os.path.join(part_out, "history.dat")).read() == before)
 
+# --- a restart in place whose history.dat is gone: refused (exit 2), its frames untouched
+gone_out = os.path.join(work, "history_gone")
+shutil.copytree(part_out, gone_out)
+os.remove(os.path.join(gone_out, "history.dat"))
+frame0 = open(os.path.join(gone_out, "frame_00000.vtu"), "rb").read()
+p = run([casca, "run", deck("gone", out=gone_out), "-q", "--restart", os.path.join(gone_out, "checkpoint.h5")])
+ck.record("restart in place with history.dat gone: refused (exit 2, 'is missing'), frame 0 unchanged",
+          p.returncode == 2 and "history.dat is missing" in p.stderr and clean(p)
+          and open(os.path.join(gone_out, "frame_00000.vtu"), "rb").read() == frame0, first_line(p))
+
 # --- a restart into a folder that holds another run's results: the history before the
 # checkpoint is the checkpoint folder's, not the folder's own (the stale rows, here the
 # earlier run's scaled by 1.5, were kept as this run's), and run.pvd lists no stale frame
@@ -277,6 +287,17 @@ tampered("contact count 1e8", lambda f: set_ds(f, "ints", np.array([0, 100000000
 tampered("time past t_end", lambda f: set_ds(f, "t", np.float64(1.0)), "outside [0, t_end]")
 tampered("NaN state", lambda f: f["qd"].__setitem__(5, np.nan), "not finite")
 tampered("without fingerprint", lambda f: f.__delitem__("fingerprint"), "no model fingerprint")
+
+
+def flip_bit(f, name, i, bit):
+    a = f[name][...]
+    w = a.view(np.uint64)
+    w[i] ^= np.uint64(1) << np.uint64(bit)
+    f[name][...] = a
+
+
+tampered("one bit of q flipped", lambda f: flip_bit(f, "q", 100, 50), "do not match their checksum")
+tampered("one bit of qdd flipped (lowest)", lambda f: flip_bit(f, "qdd", 7, 0), "do not match their checksum")
 
 # --- an error on rank 0 only (the output folder cannot be made) ends both ranks, exit 2
 blocker = os.path.join(work, "a_file")
@@ -449,7 +470,7 @@ for k in released[:2]:
                 ints, reals = f["ints"][()], f["reals"][()]
                 nact = int(ints[1])
                 old_ints = np.concatenate([ints[:2], ints[2:].reshape(nact, 7)[:, :2].ravel()])
-                del f["ints"], f["reals"]
+                del f["ints"], f["reals"], f["checksum"]
                 f["ints"] = old_ints.astype(np.int32)
                 f["reals"] = reals[:nact]
         out = os.path.join(work, "trap_%d_%s_out" % (k, kind))
@@ -460,6 +481,9 @@ for k in released[:2]:
         diffs[kind] = np.max(np.abs(h[:, phys] - tref[:, phys]) / tscale) if ok else np.inf
         ck.record("restart before release step %d from a %s checkpoint: exit 0, all steps" % (k, kind), ok,
                   first_line(p))
+        if kind == "old":
+            ck.record("restart from an old checkpoint (no checksum): a warning says it cannot be checked",
+                      "has no checksum" in p.stderr, p.stderr[-300:])
     ck.le("restart before release step %d: largest difference from the uninterrupted run / column's "
           "largest value (checkpoint without point, side, faces, mu: %.3g)" % (k, diffs["old"]), diffs["full"], 1e-12)
 

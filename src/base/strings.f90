@@ -3,7 +3,7 @@ module casca_strings
   use, intrinsic :: iso_fortran_env, only: int32, int64, real64
   implicit none
   private
-  public :: itoa, rtoa, ftoa, count_of
+  public :: itoa, rtoa, ftoa, count_of, as_word
 
   !> n as its shortest decimal text (default and 64-bit integers, e.g. HDF5's hsize_t)
   interface itoa
@@ -62,4 +62,16 @@ contains
       s = itoa_i32(n)//' '//many
     end if
   end function count_of
+  !> name with every character but letters, digits and '_' made '_' (the history's column
+  !> names: one word each, as numpy's genfromtxt(names=True) keeps them)
+  pure function as_word(name) result(w)
+    character(len=*), intent(in) :: name
+    character(len=:), allocatable :: w
+    integer :: i
+    w = trim(name)
+    do i = 1, len(w)
+      if (verify(w(i:i), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') /= 0) &
+        w(i:i) = '_'
+    end do
+  end function as_word
 end module casca_strings

@@ -833,6 +833,8 @@ contains
     type(error_t), allocatable :: e
     if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', r%st%t, &
       ' s: ', why
+    ! (an earlier step that made energy is often the cause: a node come in edge-on)
+    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
     call frame(r)
     call checkpoint(r)
     call r%ls%finish()

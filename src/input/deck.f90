@@ -424,6 +424,12 @@ contains
         call add_problem(deck, n + 1, 'unreadable line'); exit
       end if
       n = n + 1
+      ! (a byte-order mark before the first group hides it from the namelist read)
+      if (n == 1 .and. line(1:3) == achar(239)//achar(187)//achar(191)) then
+        call add_problem(deck, 1, 'the deck starts with a UTF-8 byte-order mark (an editor''s '// &
+          '"UTF-8 with BOM"), which hides its first group: save it as UTF-8 without BOM, or ASCII')
+        line(1:3) = ''
+      end if
       text = [character(len=max_line_len) :: text, line]
       line = adjustl(line)
       if (line(1:1) /= '&') cycle

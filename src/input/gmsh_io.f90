@@ -1,8 +1,10 @@
 !> Gmsh MSH files (ASCII 4.1 and 2.2) holding 10-node cubic triangles (Gmsh element type 21).
 !>
 !> Gmsh's TRI10 node order is casca's order (see casca_mesh), so connectivity is copied as is.
-!> Physical groups of points (type 15), lines (1, 8, 26) and triangles (2, 21) become the
+!> Physical groups of points (type 15), lines (1, 8, 26) and triangles (21) become the
 !> mesh's named node sets (mesh%sets): every node of their elements, in the mesh's numbering.
+!> Any other surface element (quadrangles, triangles of other orders) is an error: skipped, it
+!> would leave a part of the shell out unseen.
 !> The reader loads the whole file into memory and walks it line by line, so that every error
 !> names the file and the line where it was found; it never stops the program.
 module casca_gmsh_io
@@ -18,6 +20,8 @@ module casca_gmsh_io
   public :: read_gmsh, write_gmsh
 
   integer, parameter :: tri10_type = 21
+  !> Gmsh's triangles and quadrangles of orders 1 to 4 (MSH 2.2 gives no dimension)
+  integer, parameter :: surface_types(*) = [2, 3, 9, 10, 16, 20, 21, 22, 23, 24, 36, 37, 39, 40, 41]
   real(dp), parameter :: max_coordinate = 1e15_dp   !< [m]: far beyond any scene, far below overflow
 
   !> Position in the in-memory file: the next line starts at buf(pos:); `line` is the number of
@@ -48,12 +52,14 @@ module casca_gmsh_io
     !> nodes of physical groups: (dimension, physical tag, node tag, line of the element)
     integer :: nmember = 0
     integer(i8), allocatable :: member(:, :)
+    !> surface elements that are not 10-node triangles: how many, the first's type and line
+    integer :: nother = 0, other_type = 0, other_line = 0
   end type raw_t
 
 contains
 
-  !> Read the 10-node triangles of a Gmsh MSH 4.1 or 2.2 ASCII file. Other element types are
-  !> skipped; nodes not used by a triangle are dropped and the rest renumbered 1..nnode in
+  !> Read the 10-node triangles of a Gmsh MSH 4.1 or 2.2 ASCII file. Points, lines and volumes
+  !> are skipped, other surface elements refused; nodes not used by a triangle are dropped and the rest renumbered 1..nnode in
   !> ascending Gmsh tag order. mesh%normal is left with size (3, 0): a file has no exact normals.
   subroutine read_gmsh(path, mesh, err)
     character(len=*), intent(in) :: path
@@ -64,6 +70,7 @@ contains
     character(len=:), allocatable :: section
     integer :: s, e, version, section_line
     logical :: have_format, have_nodes, have_elements
+    character(len=160) :: what
 
     call load_file(path, cur, err)
     if (allocated(err)) return
@@ -133,6 +140,16 @@ contains
       call fail(err, cur, "end of file reached without a $Nodes section")
     else if (.not. have_elements) then
       call fail(err, cur, "end of file reached without an $Elements section")
+    else if (raw%nother > 0) then   ! (a part of the shell would be left out unseen)
+      if (raw%nother == 1) then
+        write (what, '(a, i0, a, i0)') '1 surface element that is not a 10-node triangle (Gmsh type ', &
+          raw%other_type, ', line ', raw%other_line
+      else
+        write (what, '(i0, a, i0, a, i0)') raw%nother, ' surface elements that are not 10-node ' &
+          // 'triangles (the first of Gmsh type ', raw%other_type, ', line ', raw%other_line
+      end if
+      call fail(err, cur, trim(what) // '); casca reads only type 21: mesh every surface with ' &
+                // 'Mesh.ElementOrder=3, Mesh.SecondOrderIncomplete=0 and no recombination into quadrangles')
     else if (raw%nelem == 0) then
       call fail(err, cur, "no 10-node triangles (Gmsh element type 21) in the file; mesh with " &
                 // "Mesh.ElementOrder=3 and Mesh.SecondOrderIncomplete=0")
@@ -398,6 +415,7 @@ contains
         phys = [integer ::]   ! (no $Entities section)
       end if
       nn = nodes_of_type(etype)
+      if (dim == 2 .and. etype /= tri10_type .and. nin > 0) call other_surface(raw, etype, cur%line + 1, nin)
       do k = 1, nin
         if (.not. need_line(cur, s, e, "$Elements", err)) return
         if (etype == tri10_type) then
@@ -458,6 +476,7 @@ contains
         call fail(err, cur, "expected 'element-tag type number-of-tags ...', found '" // clip(cur%buf(s:e)) // "'")
         return
       end if
+      if (etype /= tri10_type .and. any(etype == surface_types)) call other_surface(raw, etype, cur%line, 1)
       nn = nodes_of_type(etype)
       if (nn == 0) cycle                   ! volumes, quadrangles, ...: not casca's
       if (ntags < 0 .or. ntags > size(tags)) then
@@ -594,6 +613,16 @@ contains
     case default; nodes_of_type = 0
     end select
   end function nodes_of_type
+
+  !> n surface elements of Gmsh type etype, not casca's, from line
+  subroutine other_surface(raw, etype, line, n)
+    type(raw_t), intent(inout) :: raw
+    integer, intent(in) :: etype, line, n
+    if (raw%nother == 0) then
+      raw%other_type = etype; raw%other_line = line
+    end if
+    raw%nother = raw%nother + n
+  end subroutine other_surface
 
   pure integer function dim_of_type(etype)
     integer, intent(in) :: etype

@@ -6,7 +6,7 @@ module casca_sanity
   use casca_deck, only: deck_t, obstacle_cfg_t, add_problem, unset, deck_file
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
   use casca_mesh_generators, only: generated_elements, max_generated_elements
-  use casca_strings, only: itoa, rtoa
+  use casca_strings, only: itoa, rtoa, as_word
   use casca_deck_lint, only: did_you_mean
   implicit none
   private
@@ -101,6 +101,7 @@ contains
           if (find_body(b%name) /= i) &
             call add_problem(deck, n, '&body: name '''//trim(b%name)//''' used twice')
         end if
+        call distinct_column(n, '&body', b%name, deck%bodies(1:i - 1)%name)
         call finite(n, '&body '//trim(b%name)//': center, rotate_axis, rotate_angle, velocity, '// &
                     'omega or gravity', [b%center, b%rotate_axis, b%rotate_angle, b%velocity, b%omega, &
                                          b%gravity])
@@ -227,15 +228,32 @@ contains
       end associate
     end do
     do i = 1, size(deck%obstacles)
-      call check_obstacle(deck%obstacles(i))
+      call check_obstacle(deck%obstacles(i), i)
     end do
   contains
-    subroutine check_obstacle(o)
+    !> name and an earlier one differ but make the same history column word (casca_strings)
+    subroutine distinct_column(line, group, name, earlier)
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: group, name, earlier(:)
+      integer :: j
+      do j = 1, size(earlier)
+        if (earlier(j) == name .or. as_word(earlier(j)) /= as_word(name)) cycle
+        call add_problem(deck, line, group//': name '''//trim(name)//''' and '''//trim(earlier(j))// &
+          ''' make the same history column name '''//as_word(name)//''' (every character other '// &
+          'than a letter, a digit or _ becomes _); rename one')
+        return
+      end do
+    end subroutine distinct_column
+
+    subroutine check_obstacle(o, io)
       type(obstacle_cfg_t), intent(in) :: o
+      integer, intent(in) :: io
       integer :: k
       if (o%name == '') call add_problem(deck, o%line, '&obstacle: name is missing')
       if (find_body(o%name) > 0) call add_problem(deck, o%line, '&obstacle: name = '''// &
         trim(o%name)//''' is also a body''s name')
+      if (find_body(o%name) == 0) call distinct_column(o%line, '&obstacle', o%name, &
+        [character(len=len(o%name)) :: deck%bodies(:)%name, deck%obstacles(1:io - 1)%name])
       call finite(o%line, '&obstacle: point', o%point)
       call finite(o%line, '&obstacle: velocity', o%velocity)
       select case (o%shape)

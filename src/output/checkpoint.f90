@@ -1,7 +1,8 @@
 !> Restart checkpoints of a run: the state, the step-cut level and the contact active set
 !> (each constraint's node, pair, point, side, faces, multiplier and acceleration correction),
-!> with a fingerprint of the model they belong to (mesh, materials, restraints). A checkpoint
-!> is read back only when its fingerprint is this deck's and every field is in range; a state
+!> with a fingerprint of the model they belong to (mesh, materials, restraints) and a checksum
+!> of the state. A checkpoint is read back only when its fingerprint is this deck's, every
+!> field is in range and its contents match their checksum; a state
 !> that is not finite is never written (the last good checkpoint stays). The file format is
 !> casca_hdf5_io's.
 module casca_checkpoint
@@ -28,28 +29,44 @@ contains
   function model_fingerprint(model) result(fp)
     type(model_t), intent(in) :: model
     integer :: fp(2)
-    integer(int64), parameter :: p = 2147483647_int64, a(2) = [1103515245_int64, 69069_int64]
     integer(int64) :: h(2)
     integer :: b
     h = 1
-    call mix([model%nnode, model%nelem, model%ndof, model%nbody])
-    call mix(transfer(model%x0, [0_int32]))
-    call mix(reshape(model%conn, [size(model%conn)]))
-    call mix(merge(1, 0, model%fixed))
+    call mix(h, [model%nnode, model%nelem, model%ndof, model%nbody])
+    call mix(h, transfer(model%x0, [0_int32]))
+    call mix(h, reshape(model%conn, [size(model%conn)]))
+    call mix(h, merge(1, 0, model%fixed))
     do b = 1, model%nbody
-      call mix(transfer([model%body(b)%young, model%body(b)%poisson, model%body(b)%density, &
-                         model%body(b)%thickness], [0_int32]))
+      call mix(h, transfer([model%body(b)%young, model%body(b)%poisson, model%body(b)%density, &
+                            model%body(b)%thickness], [0_int32]))
     end do
     fp = int(h)
-  contains
-    subroutine mix(w)
-      integer(int32), intent(in) :: w(:)
-      integer :: i
-      do i = 1, size(w)   ! a word as 0 .. 2^32-1, so h*a + w < 2^63: no overflow
-        h = mod(h*a + iand(int(w(i), int64), 4294967295_int64), p)
-      end do
-    end subroutine mix
   end function model_fingerprint
+
+  !> The same two hashes of everything a checkpoint holds of the run's state: a file changed
+  !> or damaged after it was written (a flipped bit in q) is refused, not run from
+  function state_checksum(st, ints, reals) result(cs)
+    type(state_t), intent(in) :: st
+    integer, intent(in) :: ints(:)
+    real(dp), intent(in) :: reals(:)
+    integer :: cs(2)
+    integer(int64) :: h(2)
+    h = 1
+    call mix(h, [st%step, size(ints), size(reals)])
+    call mix(h, transfer([st%t, st%q, st%qd, st%qdd, reals], [0_int32]))
+    call mix(h, ints)
+    cs = int(h)
+  end function state_checksum
+
+  pure subroutine mix(h, w)
+    integer(int64), intent(inout) :: h(2)
+    integer(int32), intent(in) :: w(:)
+    integer(int64), parameter :: p = 2147483647_int64, a(2) = [1103515245_int64, 69069_int64]
+    integer :: i
+    do i = 1, size(w)   ! a word as 0 .. 2^32-1, so h*a + w < 2^63: no overflow
+      h = mod(h*a + iand(int(w(i), int64), 4294967295_int64), p)
+    end do
+  end subroutine mix
 
   !> Write the checkpoint path (rank 0; the caller shares err): refused if the state or the
   !> multipliers are not finite.
@@ -61,6 +78,8 @@ contains
     type(contact_t), intent(in), optional :: contact
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)
+    integer, allocatable :: ints(:)
+    real(dp), allocatable :: reals(:)
     integer :: k, nact
     if (.not. is_root()) return
     nact = 0
@@ -86,19 +105,18 @@ contains
       ! direction; then the work summed so far (friction per pair, moving obstacles); last
       ! per pair the impulse so far and the start force of the next step (rows.f90); last
       ! friction's start force per constraint (friction.f90).
-      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, &
-                            [level, nact, (contact%act(k)%node, contact%act(k)%pair, contact%act(k)%elem, &
-                                           contact%act(k)%side, contact%act(k)%face, contact%act(k)%grip, &
-                                           k=1, nact)], &
-                            [contact%act(1:nact)%lambda, contact%act(1:nact)%mu, &
-                             (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
-                              k=1, nact), contact%friction_work, contact%obstacle_work, &
-                             contact%impulse, contact%carry, (contact%act(k)%fa, k=1, nact)], err, &
-                            model_fingerprint(model), dt_next)
+      ints = [level, nact, (contact%act(k)%node, contact%act(k)%pair, contact%act(k)%elem, &
+                            contact%act(k)%side, contact%act(k)%face, contact%act(k)%grip, k=1, nact)]
+      reals = [contact%act(1:nact)%lambda, contact%act(1:nact)%mu, &
+               (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
+                k=1, nact), contact%friction_work, contact%obstacle_work, &
+               contact%impulse, contact%carry, (contact%act(k)%fa, k=1, nact)]
     else
-      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, [level, 0], &
-                            [real(dp) ::], err, model_fingerprint(model), dt_next)
+      ints = [level, 0]
+      allocate (reals(0))
     end if
+    call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
+                          model_fingerprint(model), dt_next, state_checksum(st, ints, reals))
   end subroutine save_checkpoint
 
   !> Read the checkpoint path into st, level and the contact active set, after checking that
@@ -114,14 +132,14 @@ contains
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
     real(dp), intent(out), optional :: dt_next   !< 0: not in the checkpoint
-    integer, allocatable :: ints(:), fp(:)
+    integer, allocatable :: ints(:), fp(:), cs(:)
     real(dp), allocatable :: reals(:)
     integer :: k, nact, node, pair, per
     character(len=:), allocatable :: bad
     logical :: with_fa
 
     level = 0
-    call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next)
+    call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next, cs)
     if (allocated(err)) return
     bad = ''
     if (.not. allocated(fp)) then
@@ -198,9 +216,20 @@ contains
       end if
       if (bad /= '') exit
     end do
+    if (bad == '' .and. allocated(cs)) then   ! (last: the checks above name what is out of range)
+      if (size(cs) /= 2) then
+        bad = 'its checksum is not two numbers'
+      else if (any(cs /= state_checksum(st, ints, reals))) then
+        bad = 'its contents do not match their checksum (the file was changed or damaged '// &
+              'after casca wrote it)'
+      end if
+    end if
     if (bad /= '') then
       call fatal_error(err, path//': not a checkpoint of this deck: '//bad); return
     end if
+    if (.not. allocated(cs) .and. is_root()) write (0, '(a)') 'warning: '//path// &
+      ' has no checksum (written by an older casca): its contents cannot be checked'
+
     if (.not. present(contact)) return
     contact%nact = nact   ! the active set
     if (allocated(contact%act)) then

@@ -332,7 +332,8 @@ contains
   !> Write a restart checkpoint to path (via path.part, renamed when complete).
   !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
   !> have any size, including 0.
-  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next)
+  subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
+                              checksum)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
@@ -342,6 +343,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     integer, intent(in), optional :: fingerprint(:)
     real(dp), intent(in), optional :: dt_next   !< the next step's length (error-controlled runs)
+    integer, intent(in), optional :: checksum(:)
 
     character(len=*), parameter :: who = 'write_checkpoint'
     integer(hid_t) :: fid
@@ -370,13 +372,16 @@ contains
       call put_int_1d(who, path, fid, 'fingerprint', fingerprint, err)
     if (present(dt_next) .and. .not. allocated(err)) &
       call put_real_scalar(who, path, fid, 'dt_next', dt_next, err)
+    if (present(checksum) .and. .not. allocated(err)) &
+      call put_int_1d(who, path, fid, 'checksum', checksum, err)
     if (.not. allocated(err)) call save_image(who, path, fid, err)
     call h5fclose_f(fid, h)   ! (in memory: nothing to fail on)
   end subroutine write_checkpoint
 
-  !> Read a checkpoint written by write_checkpoint (fingerprint: not allocated if it has none;
-  !> dt_next: 0 if it has none).
-  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next)
+  !> Read a checkpoint written by write_checkpoint (fingerprint, checksum: not allocated if it
+  !> has none; dt_next: 0 if it has none).
+  subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
+                             checksum)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
@@ -386,6 +391,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     integer, allocatable, intent(out), optional :: fingerprint(:)
     real(dp), intent(out), optional :: dt_next
+    integer, allocatable, intent(out), optional :: checksum(:)
 
     character(len=*), parameter :: who = 'read_checkpoint'
     integer(hid_t) :: fid
@@ -407,6 +413,10 @@ contains
     if (present(fingerprint) .and. .not. allocated(err)) then
       call h5lexists_f(fid, 'fingerprint', has_fp, h)
       if (h == 0 .and. has_fp) call get_int_1d(who, path, fid, 'fingerprint', fingerprint, err)
+    end if
+    if (present(checksum) .and. .not. allocated(err)) then
+      call h5lexists_f(fid, 'checksum', has_fp, h)
+      if (h == 0 .and. has_fp) call get_int_1d(who, path, fid, 'checksum', checksum, err)
     end if
     if (present(dt_next)) then
       dt_next = 0

@@ -19,7 +19,7 @@ module casca_output
   use casca_hdf5_io, only: h5_table_t, h5_table_create, h5_table_append, h5_table_flush, &
                            h5_table_close
   use casca_mpi, only: is_root
-  use casca_strings, only: itoa
+  use casca_strings, only: itoa, as_word
   use casca_files, only: make_dir, rename_file, delete_file, cut_to_last_line, file_kind, kind_missing, &
                          kind_regular
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
@@ -87,16 +87,10 @@ contains
                           word('friction_work')]
     if (moving) cols = [cols, word('obstacle_work')]
   contains
-    !> name with every character but letters, digits and '_' replaced by '_'
     pure function word(name) result(w)
       character(len=*), intent(in) :: name
       character(len=col_len) :: w
-      integer :: i
-      w = name
-      do i = 1, len_trim(w)
-        if (verify(w(i:i), 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_') /= 0) &
-          w(i:i) = '_'
-      end do
+      w = as_word(name)
     end function word
   end function history_columns
 
@@ -144,6 +138,14 @@ contains
     if (present(restart_dir)) then
       own = locked_here(restart_dir) .or. file_kind(restart_dir//'/history.dat') == kind_missing
       if (.not. own) earlier = restart_dir//'/history.dat'
+    end if
+    if (restart_step >= 0 .and. file_kind(earlier) == kind_missing .and. &
+        file_kind(out%dir//'/run.pvd') /= kind_missing) then   ! (its frames would be written over)
+      call fatal_error(err, 'restart: '//earlier//' is missing, though '//out%dir//' holds an '// &
+                       'earlier run''s frames (run.pvd): the history up to the checkpoint would be '// &
+                       'lost and those frames written over; put history.dat back, or restart into a '// &
+                       'new folder (--out)')
+      return
     end if
     if (restart_step < 0 .or. file_kind(earlier) == kind_missing) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)

@@ -309,7 +309,7 @@ contains
                  deck%run%tolerance /= unset))//')'
   end subroutine time_line
 
-  !> Normals into a closed body, distorted elements
+  !> Normals into a closed body, distorted elements, edges of three elements or more
   function body_warnings(model, f) result(w)
     type(model_t), intent(in) :: model
     type(body_facts_t), intent(in) :: f(:)
@@ -327,6 +327,11 @@ contains
           rtoa(min_quality)//': the area Jacobian varies by more than a factor 2 over the '// &
           'element, below 0 it folds over); the worst, element '//itoa(f(b)%worst)//', has '// &
           rtoa(f(b)%quality))
+        if (f(b)%edges%branch > 0) call add(w, 'body '''//name//''': '// &
+          count_of(f(b)%edges%branch, 'edge is', 'edges are')//' shared by three or more '// &
+          'elements (a T-junction of shells, or a stray element); the shells there share one '// &
+          'fibre, averaged from all their normals, which is normal to none of them: mesh the '// &
+          'parts that meet there as separate bodies, or remove the stray elements')
       end associate
     end do
   end function body_warnings
