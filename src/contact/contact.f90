@@ -72,6 +72,8 @@ module casca_contact
     real(dp) :: tol = 0                         !< penetration accepted [m]
     logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
     logical :: faces = .true.                   !< contact at the shell faces, else mid-surfaces
+    !> per node: on its shell's free edge (the rim), the only place a node can touch edge-on
+    logical, allocatable :: rim(:)
     !> per node: its normal constraint's compliance, penetration per unit force [m/N]
     !> (contact_set_stiffness); 0 everywhere: hard contact, no penetration (the thesis)
     real(dp), allocatable :: compliance(:)
@@ -117,6 +119,7 @@ contains
     integer :: b, e, k, n
     real(dp) :: edge, phi(10), diam
     logical, allocatable :: target_elem(:)
+    type(surface_t) :: own
     c%npairs = size(pairs, 2)
     c%pair = pairs
     allocate (c%compliance(model%nnode))
@@ -124,6 +127,17 @@ contains
     c%obstacle = obstacles
     c%tol = tol
     c%faces = faces
+    allocate (c%rim(model%nnode))
+    c%rim = .false.
+    do b = 1, model%nbody
+      if (.not. any(pairs(1, :) == b)) cycle
+      associate (bd => model%body(b))
+        call surface_init(model%conn, [(e, e=bd%elem_first, bd%elem_last)], own)
+        do k = 1, own%ntri
+          where (own%rim_vertex(:, k)) c%rim(own%tri(:, k)) = .true.
+        end do
+      end associate
+    end do
     allocate (c%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
     c%mu_d = 0; c%mu_s = 0; c%friction_work = 0
     allocate (c%impulse(3, c%npairs), c%carry(3, c%npairs))
