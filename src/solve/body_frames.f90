@@ -30,13 +30,13 @@ module casca_body_frames
 contains
 
   !> K was factorised at q: its frame is the bodies' present one. eq: equation of each dof on
-  !> this rank (0: not here).
+  !> this rank (0: not here), listed anew each time (bodies frozen or woken change it).
   subroutine frames_keep(f, model, eq, q)
     type(body_frames_t), intent(inout) :: f
     type(model_t), intent(in) :: model
     integer, intent(in) :: eq(:)
     real(dp), intent(in) :: q(:)
-    integer :: b, n, c, k, i
+    integer :: b, n, c, k, pass
     if (.not. allocated(f%free)) then
       allocate (f%free(model%nbody), f%rot(3, 3, model%nbody), f%y(3, model%nnode))
       do b = 1, model%nbody
@@ -44,24 +44,24 @@ contains
           f%free(b) = .not. any(model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7)))
         end associate
       end do
-      k = 0   ! the triplets of this rank's equations, counted then listed
-      do i = 1, 2
-        k = 0
-        do b = 1, model%nbody
-          if (.not. f%free(b)) cycle
-          do n = model%body(b)%node_first, model%body(b)%node_last
-            do c = 1, 4, 3
-              if (any(eq(dof(n, c):dof(n, c + 2)) == 0)) cycle
-              k = k + 1
-              if (i == 2) then
-                f%trip(:, k) = eq(dof(n, c):dof(n, c + 2)); f%trip_body(k) = b
-              end if
-            end do
+    end if
+    if (allocated(f%trip)) deallocate (f%trip, f%trip_body)
+    do pass = 1, 2   ! the triplets of this rank's equations, counted then listed
+      k = 0
+      do b = 1, model%nbody
+        if (.not. f%free(b)) cycle
+        do n = model%body(b)%node_first, model%body(b)%node_last
+          do c = 1, 4, 3
+            if (any(eq(dof(n, c):dof(n, c + 2)) == 0)) cycle
+            k = k + 1
+            if (pass == 2) then
+              f%trip(:, k) = eq(dof(n, c):dof(n, c + 2)); f%trip_body(k) = b
+            end if
           end do
         end do
-        if (i == 1) allocate (f%trip(3, k), f%trip_body(k))
       end do
-    end if
+      if (pass == 1) allocate (f%trip(3, k), f%trip_body(k))
+    end do
     do n = 1, model%nnode
       f%y(:, n) = q(dof(n, 1):dof(n, 3))
     end do
