@@ -246,7 +246,7 @@ if h is not None:
     ck.le("breathing_fixed: the largest one-step rise over E0 exceeds 1e-3 (the warning's threshold)",
           1e-3, rise[k] / h["total"][0])
     m = re.search(r"warning: the step to t = (\S+) s made (\S+)% of the initial energy, with 0 contacts"
-                  r" active: with no contact, the time scheme.*give a tolerance", err, re.S)
+                  r" active at its start or end: with no contact, the time scheme.*give a tolerance", err, re.S)
     ck.record("breathing_fixed: the energy warning names no contact and the time scheme, and advises a "
               "tolerance", m is not None, err[-300:])
     if m is not None:

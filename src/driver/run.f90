@@ -266,6 +266,7 @@ contains
     real(dp), allocatable :: q_before(:), qd_before(:)
     type(state_t) :: st_before
     type(contact_t), allocatable :: contact_before
+    integer :: nact0   !< contacts active at the step's start
     type(balance_t) :: bal_before
     real(dp) :: rest, made
     !> a step that makes more energy than this share of what the bodies hold is taken again
@@ -341,7 +342,9 @@ contains
         else if (r%level > 0 .and. rep%iters <= 3) then
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
-        call watch_energy(r, rest)
+        nact0 = 0
+        if (allocated(contact_before)) nact0 = contact_before%nact
+        call watch_energy(r, rest, nact0)
         if (.not. step_written(r, interval, next_frame, next_ckpt)) return
       end do
     end associate
@@ -891,13 +894,15 @@ contains
   !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
   !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
   !> and it may only grow with a dissipative scheme (stay, with a conservative one)
-  subroutine watch_energy(r, rest)
+  subroutine watch_energy(r, rest, nact_start)
     type(run_t), intent(inout) :: r
     real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
+    integer, intent(in), optional :: nact_start   !< contacts active at the step's start
     if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t
-      r%made_contacts = 0
+      r%made_contacts = 0   ! (those of a step that released them acted in it too)
       if (allocated(r%contact)) r%made_contacts = r%contact%nact
+      if (present(nact_start)) r%made_contacts = max(r%made_contacts, nact_start)
     end if
     r%rest_last = rest
     r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
@@ -965,7 +970,7 @@ contains
               trim(r%model%body(b)%name)//'''; take a shorter dt or a lower stiffness'
     end if
     write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
-      count_of(r%made_contacts, 'contact', 'contacts')//' active: '//why
+      count_of(r%made_contacts, 'contact', 'contacts')//' active at its start or end: '//why
   end subroutine warn_energy
 
   !> The energy balance's terms that the scene has: friction's, moving obstacles', a

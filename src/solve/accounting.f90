@@ -19,6 +19,7 @@ module casca_accounting
   type :: balance_t
     real(dp) :: kinetic = 0, strain = 0, work = 0, total = 0
     real(dp) :: p(3) = 0, l(3) = 0
+    real(dp) :: p_bodies = 0   !< sum of the bodies' |p| (the momenta's scale when p sums to 0)
     real(dp), allocatable :: body_kinetic(:), body_strain(:)   !< (nbody); kinetic, strain: sums
   end type balance_t
 
@@ -46,11 +47,11 @@ contains
     type(balance_t), intent(out) :: bal
     real(dp), intent(in), optional :: factor
     real(dp) :: x(3, 20), v(3, 20), mv(3, 20), lf
-    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), p, L, pressure work
-    integer :: i, e, p, b, nb
+    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), p, L, pressure work, p (3 nbody)
+    integer :: i, e, p, b, nb, pb
 
     nb = model%nbody
-    allocate (s(2*nb + 7))
+    allocate (s(5*nb + 7))
     s = 0
     lf = 1
     if (present(factor)) lf = factor
@@ -64,6 +65,8 @@ contains
       b = model%elem_body(e)
       s(b) = s(b) + 0.5_dp*sum(v*mv)
       s(2*nb + 1:2*nb + 3) = s(2*nb + 1:2*nb + 3) + sum(mv(:, 1:10), dim=2)
+      pb = 2*nb + 7 + 3*(b - 1)
+      s(pb + 1:pb + 3) = s(pb + 1:pb + 3) + sum(mv(:, 1:10), dim=2)
       do p = 1, 20
         s(2*nb + 4:2*nb + 6) = s(2*nb + 4:2*nb + 6) + cross(x(:, p), mv(:, p))
       end do
@@ -72,6 +75,7 @@ contains
     bal%body_kinetic = s(1:nb); bal%body_strain = s(nb + 1:2*nb)
     bal%kinetic = sum(bal%body_kinetic); bal%strain = sum(bal%body_strain)
     bal%p = s(2*nb + 1:2*nb + 3); bal%l = s(2*nb + 4:2*nb + 6)
+    bal%p_bodies = sum([(norm2(s(2*nb + 5 + 3*b:2*nb + 7 + 3*b)), b=1, nb)])
     bal%work = dot_product(fext, st%q - q0) + s(2*nb + 7)
     bal%total = bal%kinetic + bal%strain - bal%work
   contains
@@ -109,8 +113,9 @@ contains
   end subroutine gravity_load
 
   !> What the run kept, from the state first accounted (b0) to b: the drift of the linear
-  !> momentum (of |p0|), of the angular momentum (of |L0|, or of |p0| times the scene size
-  !> when L0 is smaller) and the change of the total energy (of E0). Contact forces keep both
+  !> momentum (of |p0|, or of the bodies' |p| summed when larger: two bodies thrown at each
+  !> other have p0 = 0), of the angular momentum (of |L0|, or of that momentum scale times the
+  !> scene size when L0 is smaller) and the change of the total energy (of E0). Contact forces keep both
   !> momenta; the Newmark step itself keeps the linear one only: its angular momentum
   !> drifts with dt (docs/method.md), which is why the figure is printed.
   !> external: restraints, loads or obstacles act, so the momenta change by design and the
@@ -122,7 +127,7 @@ contains
     character(len=:), allocatable :: line
     character(len=200) :: buf
     real(dp) :: pref, lref
-    pref = max(norm2(b0%p), tiny(1._dp))
+    pref = max(norm2(b0%p), b0%p_bodies, tiny(1._dp))
     lref = max(norm2(b0%l), pref*length)
     if (external) then   ! (absolute: the bodies may start at rest)
       write (buf, '(a,es9.2,a,es9.2,a,es11.4,a)') 'changed by supports, loads or obstacles: linear '// &
