@@ -27,6 +27,10 @@ module casca_contact
     !> the node's line along n at the configuration the internal force is taken at; the rows
     !> of C keep xi and shp, which define the gap
     real(dp) :: xif(2) = 0, shpf(10) = 0
+    !> the normal the force acts along: n, but for a curved obstacle its normal at the node's
+    !> face point at that configuration (contact_force_points), so that a frictionless force
+    !> has no moment about the obstacle's axis or centre there
+    real(dp) :: nf(3) = 0
     real(dp) :: gap = 0, lambda = 0
     real(dp) :: g0 = 0          !< the gap at the step's start (0 for a constraint made in it)
     real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)

@@ -341,7 +341,7 @@ contains
     real(dp), intent(out) :: w(2*11), dir(3)
     integer :: j, nn
     select case (kind)
-    case (0); dir = a%n
+    case (0); dir = merge(a%nf, a%n, force)
     case (1, 2); dir = a%t(:, kind)
     case default; dir = a%s
     end select
@@ -438,7 +438,7 @@ contains
   !> The force acts at the gap's point until force_point finds its own
   pure subroutine hold_force_point(con)
     type(constraint_t), intent(inout) :: con
-    con%xif = con%xi; con%shpf = con%shp
+    con%xif = con%xi; con%shpf = con%shp; con%nf = con%n
   end subroutine hold_force_point
 
   !> Unit normal of the cubic surface with node positions xe where the shape derivatives are dphi
