@@ -196,6 +196,11 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["&body", "unknown key 'pressure'", "(a key of &load)"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
     ("a byte-order mark", lambda s: "\ufeff" + s, ["byte-order mark", ":1:"]),
+    ("a group left open", lambda s: s.replace("  interval = 5.0e-4\n", "  interval = 5.0e-4,\n", 1)
+     .replace("  track_body = 'ring1', 'ring2'\n/\n", "  track_body = 'ring1', 'ring2'\n", 1),
+     ["&output is not closed with '/' before the next group, at line 8", ":4:"]),
+    ("groups closed with &end", lambda s: s.replace("/\n&output", "&end\n&output", 1),
+     ["&run is closed with &end (line 3)", ":1:"]),
     ("names making one history column", lambda s: s.replace("'ring1'", "'ring 1'").replace("'ring2'", "'ring_1'"),
      ["name 'ring_1' and 'ring 1' make the same history column name 'ring_1'", ":14:"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),

@@ -2,6 +2,7 @@
 !> be one the group knows and every value of the right type. gfortran's messages for these
 !> mistakes ("Cannot match namelist object name 'abc'") do not name the field; these do.
 module casca_deck_lint
+  use casca_strings, only: itoa
   implicit none
   private
   public :: lint_group, lower, did_you_mean
@@ -88,11 +89,24 @@ contains
     s = ''
     allocate (lineof(0))
     do i = first, size(text)
+      if (i > first .and. starts_group(text(i))) exit   ! (the next group: this one is open)
       k = comment_start(text(i))
       s = s//text(i)(1:k - 1)//' '
       lineof = [lineof, spread(i, 1, k)]
       if (group_ends(s)) exit
     end do
+    if (.not. group_ends(s)) then   ! (the read would run into the next group: keys by the dozen)
+      if (i > size(text)) then
+        call report(first, '&'//group//' is not closed with ''/'' before the end of the deck')
+      else if (lower(adjustl(text(i))) == '&end') then
+        call report(first, '&'//group//' is closed with &end (line '//itoa(i)//'), which casca '// &
+                    'does not read: end each group with ''/''')
+      else
+        call report(first, '&'//group//' is not closed with ''/'' before the next group, at line '// &
+                    itoa(i))
+      end if
+      return
+    end if
     n = len(s)
     p = index(s, '&') + 1 + len_trim(group)
     key = ''; t = ' '
@@ -213,6 +227,15 @@ contains
   end function comment_start
 
   !> the text holds a '/' outside quotes (end of the group)
+  !> a line whose first character that is not a blank is '&'
+  pure logical function starts_group(line)
+    character(len=*), intent(in) :: line
+    integer :: i
+    i = verify(line, ' '//achar(9))
+    starts_group = .false.
+    if (i > 0) starts_group = line(i:i) == '&'
+  end function starts_group
+
   pure logical function group_ends(s)
     character(len=*), intent(in) :: s
     character(len=1) :: q
