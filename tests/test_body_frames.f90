@@ -23,8 +23,8 @@ program test_body_frames
   logical, allocatable :: frozen(:)
   type(rows_t) :: rows, turned_rows
   type(error_t), allocatable :: err
-  real(dp), allocatable :: q(:), qt(:), r(:), b(:), x(:)
-  real(dp) :: turn(3, 3), axis(3), th, force, gap, energy
+  real(dp), allocatable :: q(:), qt(:), b(:)
+  real(dp) :: turn(3, 3), axis(3), th, force, gap
   integer :: i, j
 
   call mpi_start()
@@ -45,37 +45,25 @@ program test_body_frames
   if (allocated(err)) error stop 'assembly'
   call ring_rows(model, asm, q, rows)
   call factorised(model, asm, q, rows, ls)
-  call ring_rows(model, asm, qt, turned_rows, turn)
+  call turned_system()
   call check_true('contact rows at the turned rings', size(turned_rows%gap) > 0)
-  allocate (r(model%ndof), frozen(model%ndof))
-  call assemble(model, asm, qt, .true., r, energy, 4e8_dp, qt)   ! K' (the factors stay K's)
-
-  allocate (b(asm%neq + size(turned_rows%gap)), x(asm%neq + size(turned_rows%gap)))
-  do i = 1, asm%neq
-    b(i) = sin(0.37_dp*i)*1e3_dp
-  end do
-  b(asm%neq + 1:) = -turned_rows%gap
-  call kkt_solve(ls, asm, turned_rows, b, .false., x, err)
-  if (allocated(err)) error stop 'solve, frames not followed'
-  call saddle_residuals(asm, turned_rows, b, x, force, gap)
+  call solve_turned(ls, force, gap)
   write (*, '(a, es10.3)') 'frames not followed: force residual', force
   call check_true('frames not followed: the old factors do not solve the turned system (> 1e-4)', &
                   force > 1e-4_dp)
-
   call follow_bodies(ls, model, qt)
   call check_le('the rotation found, ring 1 (max entry difference)', &
                 maxval(abs(ls%frames%rot(:, :, 1) - turn)), 1e-12_dp)
   call check_le('the rotation found, ring 2 (max entry difference)', &
                 maxval(abs(ls%frames%rot(:, :, 2) - turn)), 1e-12_dp)
-  call kkt_solve(ls, asm, turned_rows, b, .false., x, err)
-  if (allocated(err)) error stop 'solve, frames followed'
-  call saddle_residuals(asm, turned_rows, b, x, force, gap)
+  call solve_turned(ls, force, gap)
   call check_le('frames followed: |K x + B^T dl - b| / max(|b|, |K x|, |B^T dl|)', force, 1e-10_dp)
   call check_le('frames followed: |C x + gap| / |gap|', gap, 1e-10_dp)
   call ls%finish()
 
   ! the same after the equations were numbered anew: first ring 1 frozen (advanced without
   ! solving), then both solved again, as when a body in free flight wakes
+  allocate (frozen(model%ndof))
   frozen = .false.
   frozen(dof(model%body(1)%node_first, 1):dof(model%body(1)%node_last, 7)) = .true.
   call assembly_setup(model, asm, err, frozen, split=.true.)
@@ -87,21 +75,42 @@ program test_body_frames
   call ls2%new_pattern()
   call ring_rows(model, asm, q, rows)
   call factorised(model, asm, q, rows, ls2)
-  call ring_rows(model, asm, qt, turned_rows, turn)
-  call assemble(model, asm, qt, .true., r, energy, 4e8_dp, qt)
-  deallocate (b, x)
-  allocate (b(asm%neq + size(turned_rows%gap)), x(asm%neq + size(turned_rows%gap)))
-  do i = 1, asm%neq
-    b(i) = sin(0.37_dp*i)*1e3_dp
-  end do
-  b(asm%neq + 1:) = -turned_rows%gap
+  call turned_system()
   call follow_bodies(ls2, model, qt)
-  call kkt_solve(ls2, asm, turned_rows, b, .false., x, err)
-  if (allocated(err)) error stop 'solve, equations numbered anew'
-  call saddle_residuals(asm, turned_rows, b, x, force, gap)
+  call solve_turned(ls2, force, gap)
   call check_le('equations numbered anew (ring 1 woken): |K x + B^T dl - b| / max(...)', force, 1e-10_dp)
   call check_le('equations numbered anew (ring 1 woken): |C x + gap| / |gap|', gap, 1e-10_dp)
   call ls2%finish()
   call check_summary()
   call mpi_stop()
+contains
+
+  !> the rings turned (qt), their rows there, K' assembled there (the factors stay K's) and a
+  !> right-hand side b = [f; -gap]
+  subroutine turned_system()
+    real(dp), allocatable :: r(:)
+    real(dp) :: energy
+    integer :: i
+    call ring_rows(model, asm, qt, turned_rows, turn)
+    allocate (r(model%ndof))
+    call assemble(model, asm, qt, .true., r, energy, 4e8_dp, qt)
+    if (allocated(b)) deallocate (b)
+    allocate (b(asm%neq + size(turned_rows%gap)))
+    do i = 1, asm%neq
+      b(i) = sin(0.37_dp*i)*1e3_dp
+    end do
+    b(asm%neq + 1:) = -turned_rows%gap
+  end subroutine turned_system
+
+  !> the Schur solve of the turned system with ls's factors, and its residuals
+  subroutine solve_turned(lsys, force, gap)
+    type(linear_system_t), intent(inout) :: lsys
+    real(dp), intent(out) :: force, gap
+    real(dp), allocatable :: x(:)
+    type(error_t), allocatable :: e
+    allocate (x(size(b)))
+    call kkt_solve(lsys, asm, turned_rows, b, .false., x, e)
+    if (allocated(e)) error stop 'solve'
+    call saddle_residuals(asm, turned_rows, b, x, force, gap)
+  end subroutine solve_turned
 end program test_body_frames
