@@ -226,7 +226,6 @@ contains
     end do
   end function comment_start
 
-  !> the text holds a '/' outside quotes (end of the group)
   !> a line whose first character that is not a blank is '&'
   pure logical function starts_group(line)
     character(len=*), intent(in) :: line
@@ -236,6 +235,7 @@ contains
     if (i > 0) starts_group = line(i:i) == '&'
   end function starts_group
 
+  !> the text holds a '/' outside quotes (end of the group)
   pure logical function group_ends(s)
     character(len=*), intent(in) :: s
     character(len=1) :: q

@@ -59,8 +59,9 @@ module casca_gmsh_io
 contains
 
   !> Read the 10-node triangles of a Gmsh MSH 4.1 or 2.2 ASCII file. Points, lines and volumes
-  !> are skipped, other surface elements refused; nodes not used by a triangle are dropped and the rest renumbered 1..nnode in
-  !> ascending Gmsh tag order. mesh%normal is left with size (3, 0): a file has no exact normals.
+  !> are skipped, other surface elements refused; nodes not used by a triangle are dropped
+  !> and the rest renumbered 1..nnode in ascending Gmsh tag order. mesh%normal is left with
+  !> size (3, 0): a file has no exact normals.
   subroutine read_gmsh(path, mesh, err)
     character(len=*), intent(in) :: path
     type(mesh_t), intent(out) :: mesh

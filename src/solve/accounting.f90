@@ -47,15 +47,15 @@ contains
     type(balance_t), intent(out) :: bal
     real(dp), intent(in), optional :: factor
     real(dp) :: x(3, 20), v(3, 20), mv(3, 20), lf
-    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), p, L, pressure work, p (3 nbody)
+    real(dp), allocatable :: s(:)   !< kinetic (nbody), strain (nbody), L, pressure work, p (3 nbody)
     integer :: i, e, p, b, nb, pb
 
     nb = model%nbody
-    allocate (s(5*nb + 7))
+    allocate (s(5*nb + 4))
     s = 0
     lf = 1
     if (present(factor)) lf = factor
-    s(2*nb + 7) = pressure_work_local(model, asm%owned, st%q, q0, lf)
+    s(2*nb + 4) = pressure_work_local(model, asm%owned, st%q, q0, lf)
     call strain_energy_local(model, asm, st%q, s(nb + 1:2*nb))
     do i = 1, size(asm%owned)   ! every body: frozen ones move too
       e = asm%owned(i)
@@ -64,19 +64,19 @@ contains
       mv = matmul(v, model%emass(:, :, e))
       b = model%elem_body(e)
       s(b) = s(b) + 0.5_dp*sum(v*mv)
-      s(2*nb + 1:2*nb + 3) = s(2*nb + 1:2*nb + 3) + sum(mv(:, 1:10), dim=2)
-      pb = 2*nb + 7 + 3*(b - 1)
+      pb = 2*nb + 4 + 3*(b - 1)   ! (the body's momentum; the total is their sum)
       s(pb + 1:pb + 3) = s(pb + 1:pb + 3) + sum(mv(:, 1:10), dim=2)
       do p = 1, 20
-        s(2*nb + 4:2*nb + 6) = s(2*nb + 4:2*nb + 6) + cross(x(:, p), mv(:, p))
+        s(2*nb + 1:2*nb + 3) = s(2*nb + 1:2*nb + 3) + cross(x(:, p), mv(:, p))
       end do
     end do
     call sum_all(s)
     bal%body_kinetic = s(1:nb); bal%body_strain = s(nb + 1:2*nb)
     bal%kinetic = sum(bal%body_kinetic); bal%strain = sum(bal%body_strain)
-    bal%p = s(2*nb + 1:2*nb + 3); bal%l = s(2*nb + 4:2*nb + 6)
-    bal%p_bodies = sum([(norm2(s(2*nb + 5 + 3*b:2*nb + 7 + 3*b)), b=1, nb)])
-    bal%work = dot_product(fext, st%q - q0) + s(2*nb + 7)
+    bal%l = s(2*nb + 1:2*nb + 3)
+    bal%p = sum(reshape(s(2*nb + 5:), [3, nb]), dim=2)
+    bal%p_bodies = sum(norm2(reshape(s(2*nb + 5:), [3, nb]), dim=1))
+    bal%work = dot_product(fext, st%q - q0) + s(2*nb + 4)
     bal%total = bal%kinetic + bal%strain - bal%work
   contains
     !> the 20 vector parameters (Y^l, G^l) of element e from a full-length vector

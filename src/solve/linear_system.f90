@@ -164,19 +164,28 @@ contains
     type(error_t), allocatable, intent(out) :: err
     type(error_t), allocatable :: e
     real(dp), allocatable :: bt(:, :)
-    integer :: lo, hi, s
     xx = 0
-    bt = bb
-    if (ls%schur) call frames_turn(ls%frames, bt, back=.true.)   ! (saddle: C is in its factors)
-    do s = 1, nblocks
-      if (asm%blk(s)%neq == 0) cycle
-      lo = asm%blk(s)%off + 1
-      hi = asm%blk(s)%off + asm%blk(s)%neq + merge(extra, 0, s == 1)
-      call ls%solver(s)%solve(bt(lo:hi, :), xx(lo:hi, :), e)
-      if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
-    end do
-    call share_error(err)
-    if (ls%schur) call frames_turn(ls%frames, xx, back=.false.)
+    if (ls%schur .and. ls%frames%turned) then   ! (saddle: C is in its factors, never turned)
+      bt = bb
+      call frames_turn(ls%frames, bt, back=.true.)
+      call each_block(bt)
+      call frames_turn(ls%frames, xx, back=.false.)
+    else
+      call each_block(bb)
+    end if
+  contains
+    subroutine each_block(b)
+      real(dp), intent(in) :: b(:, :)
+      integer :: lo, hi, s
+      do s = 1, nblocks
+        if (asm%blk(s)%neq == 0) cycle
+        lo = asm%blk(s)%off + 1
+        hi = asm%blk(s)%off + asm%blk(s)%neq + merge(extra, 0, s == 1)
+        call ls%solver(s)%solve(b(lo:hi, :), xx(lo:hi, :), e)
+        if (allocated(e) .and. .not. allocated(err)) call move_alloc(e, err)
+      end do
+      call share_error(err)
+    end subroutine each_block
   end subroutine solve_blocks
 
   !> With kept factors on the Schur path: solve in the frames the free bodies have turned to
