@@ -152,8 +152,6 @@ contains
         call timer_stop(t_factor)
         if (allocated(err)) exit
         rep%factorisations = rep%factorisations + 1
-      else
-        call follow_bodies(ls, model, q)
       end if
       call take_increment()
       if (allocated(err)) exit
@@ -279,7 +277,7 @@ contains
       logical :: renew
       renew = .false.
       if (rep%nincr >= set_start + 1) renew = contraction(rep) > 0.25_dp
-      call solve_increment(model, asm, ls, rows, res, renew, d, err)
+      call solve_increment(model, asm, ls, rows, q, res, renew, d, err)
       if (allocated(err)) return
       inc%q = q; inc%dq = d(1:model%ndof); inc%dlambda = d(model%ndof + 1:)
       if (nc > 0) then
@@ -418,11 +416,12 @@ contains
 
   !> Solve the saddle-point system for the increment d = (dq, dlambda) of the residual res
   !> and the rows' gaps, gathered whole on every rank
-  subroutine solve_increment(model, asm, ls, rows, res, renew, d, err)
+  subroutine solve_increment(model, asm, ls, rows, q, res, renew, d, err)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(in) :: asm
     type(linear_system_t), intent(inout) :: ls
     type(rows_t), intent(in) :: rows
+    real(dp), intent(in) :: q(:)   !< the iterate (the bodies' turn since K's factors)
     real(dp), intent(in) :: res(:)
     logical, intent(in) :: renew
     real(dp), allocatable, intent(out) :: d(:)
@@ -436,6 +435,7 @@ contains
     end do
     b(asm%neq + 1:) = -rows%gap
     call timer_start(t_solve)
+    call follow_bodies(ls, model, q)   ! (no turn right after a factorisation at q)
     call kkt_solve(ls, asm, rows, b, renew, x, err)
     if (allocated(err)) then
       call timer_stop(t_solve); return
