@@ -24,7 +24,7 @@ program casca
   use casca_mumps_solver, only: mumps_version
   use casca_hdf5_io, only: hdf5_version
   use casca_run, only: run_deck, load_scene, exit_ok, exit_input
-  use casca_deck, only: deck_t
+  use casca_deck, only: deck_t, body_cfg_t, counts_for_size, unset
   use casca_model, only: model_t
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_ring, mesh_sphere, mesh_plate
@@ -199,6 +199,7 @@ contains
         'casca mesh ring   --radius R --width W --n-around N --n-across M -o FILE.msh', &
         'casca mesh sphere --radius R --n-div N -o FILE.msh', &
         'casca mesh plate|strip --lx A --ly B --nx N --ny M -o FILE.msh', &
+        'casca mesh KIND ... --size H -o FILE.msh      (counts for element edges of about H)', &
         '', &
         'Writes a mesh of 10-node (cubic) triangles to FILE.msh (Gmsh MSH 4.1) for a deck''s', &
         '&body mesh = ''file''. Sizes in m; each grid cell is two triangles.', &
@@ -209,6 +210,10 @@ contains
         '  plate    rectangle [0,A] x [0,B] (1 x 1) in the xy plane, N (4) by M (1) cells;', &
         '  strip    the same', &
         'options:', &
+        '  --size H          the counts for element edges of at most about H [m], as a deck''s', &
+        '                    element_size: ring 2 pi R / H around and W / H across, sphere', &
+        '                    (R / sin 72 deg) / H per icosahedron edge, plate A / H by B / H,', &
+        '                    rounded up; it replaces the counts given', &
         '  -o, --out FILE    the mesh file to write (required)', &
         '  -h, --help        this text', &
         'exit codes: 0 written, 2 bad input']
@@ -306,15 +311,14 @@ contains
   subroutine cmd_mesh()
     type(mesh_t) :: mesh
     type(error_t), allocatable :: err
-    character(len=:), allocatable :: kind, out, key, val
-    real(dp) :: radius, width, lx, ly
-    integer :: n_around, n_across, n_div, nx, ny, i, ios
+    character(len=:), allocatable :: out, key, val
+    ! the deck's body holds the generator's sizes and defaults, and its rule for element_size
+    type(body_cfg_t) :: b
+    integer :: i, ios
     if (wants_help()) then
       call command_help('mesh'); return
     end if
-    kind = arg(2); out = ''
-    radius = 1; width = 0.2_dp; lx = 1; ly = 1; n_around = 20; n_across = 1; n_div = 6
-    nx = 4; ny = 1
+    b%mesh = arg(2); out = ''
     i = 3
     do while (i <= command_argument_count())
       key = arg(i)
@@ -322,42 +326,51 @@ contains
         if (is_root()) write (0, '(a)') 'error: mesh: '//key//' needs a value'
         code = exit_input; return
       end if
-      ios = 0
+      ios = 0; val = arg(i + 1)
       select case (key)
-      case ('-o', '--out'); out = arg(i + 1)
-      case ('--radius'); val = arg(i + 1); read (val, *, iostat=ios) radius
-      case ('--width'); val = arg(i + 1); read (val, *, iostat=ios) width
-      case ('--lx'); val = arg(i + 1); read (val, *, iostat=ios) lx
-      case ('--ly'); val = arg(i + 1); read (val, *, iostat=ios) ly
-      case ('--n-around'); val = arg(i + 1); read (val, *, iostat=ios) n_around
-      case ('--n-across'); val = arg(i + 1); read (val, *, iostat=ios) n_across
-      case ('--n-div'); val = arg(i + 1); read (val, *, iostat=ios) n_div
-      case ('--nx'); val = arg(i + 1); read (val, *, iostat=ios) nx
-      case ('--ny'); val = arg(i + 1); read (val, *, iostat=ios) ny
+      case ('-o', '--out'); out = val
+      case ('--radius'); read (val, *, iostat=ios) b%radius
+      case ('--width'); read (val, *, iostat=ios) b%width
+      case ('--lx'); read (val, *, iostat=ios) b%lx
+      case ('--ly'); read (val, *, iostat=ios) b%ly
+      case ('--n-around'); read (val, *, iostat=ios) b%n_around
+      case ('--n-across'); read (val, *, iostat=ios) b%n_across
+      case ('--n-div'); read (val, *, iostat=ios) b%n_div
+      case ('--nx'); read (val, *, iostat=ios) b%nx
+      case ('--ny'); read (val, *, iostat=ios) b%ny
+      case ('--size')
+        read (val, *, iostat=ios) b%element_size
+        if (ios == 0 .and. .not. (b%element_size > 0 .and. b%element_size < huge(1._dp))) then
+          if (is_root()) write (0, '(a)') 'error: mesh: --size must be a positive length, got "'// &
+            val//'"'
+          code = exit_input; return
+        end if
       case default
         if (is_root()) write (0, '(a)') 'error: mesh: unknown option '//key
         code = exit_input; return
       end select
       if (ios /= 0) then
         if (is_root()) write (0, '(a)') 'error: mesh: '//key//' expects a number, got "'// &
-          arg(i + 1)//'"'
+          val//'"'
         code = exit_input; return
       end if
       i = i + 2
     end do
+    ! --size wins over the counts, given before or after it
+    if (b%element_size /= unset) call counts_for_size(b)
     if (out == '') then
       if (is_root()) write (0, '(a)') 'error: mesh: give the output file with -o FILE.msh'
       code = exit_input; return
     end if
-    select case (kind)
+    select case (b%mesh)
     case ('ring')
-      call mesh_ring(radius, width, n_around, n_across, mesh, err)
+      call mesh_ring(b%radius, b%width, b%n_around, b%n_across, mesh, err)
     case ('sphere')
-      call mesh_sphere(radius, n_div, mesh, err)
+      call mesh_sphere(b%radius, b%n_div, mesh, err)
     case ('plate', 'strip')
-      call mesh_plate(lx, ly, nx, ny, mesh, err)
+      call mesh_plate(b%lx, b%ly, b%nx, b%ny, mesh, err)
     case default
-      if (is_root()) write (0, '(a)') 'error: mesh: unknown kind "'//kind// &
+      if (is_root()) write (0, '(a)') 'error: mesh: unknown kind "'//trim(b%mesh)// &
         '" (ring, sphere, plate, strip)'
       code = exit_input; return
     end select

@@ -13,6 +13,10 @@ Asserted about the command line itself (issue 17):
   H5public.h where those are found; under `mpirun -np 2` exit 0 and printed once;
 - plurals: `casca check` of a one-body deck says "1 body," (never "1 bodies"), of a two-body
   deck "2 bodies,"; `casca mesh` says "N elements, M nodes";
+- `casca mesh KIND --size H` (issue 18): the element counts equal those counted here from the
+  geometry (ring ceil(2 pi R / H) x ceil(W / H) cells, sphere 20 ceil(R / (H sin 72 deg))^2
+  triangles, plate ceil(A / H) x ceil(B / H) cells, two triangles a cell), also when counts
+  are given beside it; a size that is not a positive number exits 2 naming --size;
 - gnuplot's messages stay off the terminal: `casca run` of the static cantilever example (flat
   energy curves, on which gnuplot warns "empty y range") and `casca plot` of its folder exit 0
   with no "empty y range" in their stdout or stderr, and the warning is in the folder's
@@ -117,6 +121,21 @@ ck.record("casca check of a two-body deck: '2 bodies,'", p.returncode == 0 and "
 p = run([casca, "mesh", "plate", "--nx", "1", "--ny", "1", "-o", os.path.join(work, "one_cell.msh")])
 ck.record("casca mesh: '2 elements, 16 nodes'", p.returncode == 0 and
           p.stdout.strip().endswith(": 2 elements, 16 nodes"), p.stdout.strip())
+# --size: the counts from the geometry, as a deck's element_size
+import math
+for args, expect in ((["ring", "--radius", "1", "--width", "0.2", "--size", "0.1"],
+                      2 * math.ceil(2 * math.pi / 0.1) * math.ceil(0.2 / 0.1)),
+                     (["sphere", "--radius", "0.5", "--n-div", "2", "--size", "0.1"],
+                      20 * math.ceil(0.5 / (0.1 * math.sin(math.radians(72)))) ** 2),
+                     (["plate", "--lx", "2", "--ly", "0.5", "--size", "0.3"],
+                      2 * math.ceil(2 / 0.3) * math.ceil(0.5 / 0.3))):
+    p = run([casca, "mesh"] + args + ["-o", os.path.join(work, "sized.msh")])
+    ck.record("casca mesh %s: %d elements" % (" ".join(args), expect), p.returncode == 0 and
+              p.stdout.strip().split(": ")[-1].startswith("%d elements," % expect), p.stdout.strip())
+for bad in ("-0.1", "big"):
+    p = run([casca, "mesh", "sphere", "--size", bad, "-o", os.path.join(work, "sized.msh")])
+    ck.record("casca mesh --size %s: exit 2 naming --size" % bad,
+              p.returncode == 2 and "--size" in p.stderr, p.stderr.strip())
 
 p = run([casca, "frobnicate"])
 ck.record("unknown command: exit 2", p.returncode == 2 and "unknown command" in p.stderr)

@@ -20,6 +20,7 @@ module casca_deck
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
   public :: contact_cfg_t, obstacle_cfg_t, read_deck, add_problem, max_track, unset, deck_file, default_newton_tol
+  public :: counts_for_size
 
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
