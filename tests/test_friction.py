@@ -18,6 +18,10 @@ static     static coefficient 0.8, dynamic 0.3, pushed by 0.4 m g (above the dyn
            among the nodes while the cubic elements' consistent mass spreads the weight unevenly
            (little on the vertices): at static_friction 0.6 some nodes pass their cone, slide,
            and the block follows, so the static margin tested is 2.
+own        the same push with the obstacle's own friction = 0.8 alone and &contact friction 0.3,
+           static_friction 0.5: the obstacle's coefficient is its static one too (before
+           2026-11-27 its pair took &contact's 0.5, below its dynamic 0.8, and crept by
+           stick-slip): it does not move (1e-9 m).
 pair       the block thrown at 1 m/s onto a meshed, fixed steel plate (friction between bodies)
            with &contact friction = 0.6 but pair_friction = 0.25 for (block, plate): it
            decelerates at 0.25 g (1%).
@@ -131,6 +135,14 @@ h, _ = go("static", block_deck(load=f"&load body = 'block', force = {F}, 0.0, 0.
                                friction="friction = 0.3, static_friction = 0.8"))
 if h is not None:
     ck.le("static: largest displacement along x [m]", np.max(np.abs(h["p1_x"] - h["p1_x"][0])), 1e-9)
+
+# the obstacle's own friction = 0.8 given alone is its static coefficient too, whatever
+# &contact's static_friction (0.5 here): the same push holds it
+h, _ = go("own", block_deck(load=f"&load body = 'block', force = {F}, 0.0, 0.0 /\n"
+                                 "&contact friction = 0.3, static_friction = 0.5 /\n",
+                            friction="friction = 0.8"))
+if h is not None:
+    ck.le("own: largest displacement along x [m]", np.max(np.abs(h["p1_x"] - h["p1_x"][0])), 1e-9)
 
 plate = os.path.join(work, "plate.msh")
 run([casca, "mesh", "plate", "--lx", "1.0", "--ly", "0.4", "--nx", "5", "--ny", "2", "-o", plate])

@@ -8,12 +8,14 @@ module casca_contact_rows
   use casca_contact_projection, only: constraint_entries, constraint_row, max_row, force_point
   use casca_obstacle, only: obstacle_point
   use casca_time_scheme, only: scheme_t
+  use casca_lapack, only: dpotrf, dpotrs
   implicit none
   private
   public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
   public :: contact_stored_energy
   public :: constraint_nkinds, slip_force, friction_force, add_step_impulse, pair_forces, contact_force_points
+  public :: start_carry
 
 contains
 
@@ -221,8 +223,9 @@ contains
   !> less the normal force of the constraints released taken out of it (newmark.f90);
   !> A_end = (F_end - alpha_m A_start)/(1 - alpha_m) with F_end the end forces (pair_forces
   !> as Newton left them: f_end); nu the velocity correction's impulses, in row order, along
-  !> the normals it took (Newmark: A_end = F_end). (dt F_end summed over the steps is off by
-  !> Newton's tolerance; this is exact.)
+  !> the normals it took (Newmark: A_end = F_end). Every normal part is along nf, as the force
+  !> rows that applied it (build_rows; nf = n but on curved obstacles under generalized-alpha).
+  !> (dt F_end summed over the steps is off by Newton's tolerance; this is exact.)
   subroutine add_step_impulse(c, ts, released, nu, f_end)
     type(contact_t), intent(inout) :: c
     type(scheme_t), intent(in) :: ts
@@ -233,15 +236,15 @@ contains
     dt = ts%dt; g = ts%gamma
     do k = 1, size(released)
       associate (a => released(k))
-        c%carry(:, a%pair) = c%carry(:, a%pair) - (a%mu - a%lambda)*a%n
+        c%carry(:, a%pair) = c%carry(:, a%pair) - (a%mu - a%lambda/(1 - ts%alpha_m))*a%nf
       end associate
     end do
     j = 0; mu = 0
     r = 0
     do k = 1, c%nact
       associate (a => c%act(k))
-        j(:, a%pair) = j(:, a%pair) + nu(r + 1)*a%n
-        mu(:, a%pair) = mu(:, a%pair) + a%mu*a%n
+        j(:, a%pair) = j(:, a%pair) + nu(r + 1)*a%nf
+        mu(:, a%pair) = mu(:, a%pair) + a%mu*a%nf
         if (a%grip == stick) then
           j(:, a%pair) = j(:, a%pair) + nu(r + 2)*a%t(:, 1) + nu(r + 3)*a%t(:, 2)
           mu(:, a%pair) = mu(:, a%pair) + a%mut(1)*a%t(:, 1) + a%mut(2)*a%t(:, 2)
@@ -258,6 +261,71 @@ contains
       if (t <= 0) c%obstacle_work = c%obstacle_work + dot_product(j(:, k), c%obstacle(-t)%velocity)
     end do
   end subroutine add_step_impulse
+
+  !> The contact's share of M a at the start (c%carry) when bodies start held by their
+  !> contacts (start_acceleration gives them a = 0): share(:, b) is what the pairs must give
+  !> body b between them (its weight reversed; 0 for a free body without gravity). Per pair,
+  !> the least forces that give every free body of the pairs near contact its share, with
+  !> obstacles and restrained bodies as the ground: f = A^T (A A^T)^-1 share, A the pairs'
+  !> incidence (+1 on the impactor, -1 on the target). Exact where those pairs form a tree (a
+  !> plate on a floor, a stack of plates); where they close a loop the split is the
+  !> stiffnesses', which the start does not know, and this one is a plausible one (each
+  !> body's total is still exact). A group nothing grounds keeps 0.
+  subroutine start_carry(c, near, share, ground)
+    type(contact_t), intent(inout) :: c
+    logical, intent(in) :: near(:)            !< per pair: near contact at the start
+    real(dp), intent(in) :: share(:, :)       !< (3, nbody)
+    logical, intent(in) :: ground(:)          !< per body: restrained
+    integer :: row(size(ground)), nb, k, i, j, info
+    real(dp), allocatable :: l(:, :), y(:, :)
+    row = 0; nb = 0
+    do k = 1, c%npairs
+      if (.not. near(k)) cycle
+      do j = 1, 2
+        i = c%pair(j, k)
+        if (i <= 0) cycle
+        if (ground(i) .or. row(i) > 0) cycle
+        nb = nb + 1; row(i) = nb
+      end do
+    end do
+    if (nb == 0) return
+    allocate (l(nb, nb), y(nb, 3))
+    l = 0; y = 0
+    do i = 1, size(ground)
+      if (row(i) > 0) y(row(i), :) = share(:, i)
+    end do
+    do k = 1, c%npairs
+      if (.not. near(k)) cycle
+      call add_incidence(row(c%pair(1, k)), row(c%pair(1, k)), 1._dp)
+      if (c%pair(2, k) > 0) then
+        call add_incidence(row(c%pair(2, k)), row(c%pair(2, k)), 1._dp)
+        call add_incidence(row(c%pair(1, k)), row(c%pair(2, k)), -1._dp)
+        call add_incidence(row(c%pair(2, k)), row(c%pair(1, k)), -1._dp)
+      end if
+    end do
+    call dpotrf('L', nb, l, nb, info)
+    if (info /= 0) return
+    call dpotrs('L', nb, 3, l, nb, y, nb, info)
+    if (info /= 0) return
+    do k = 1, c%npairs
+      if (.not. near(k)) cycle
+      c%carry(:, k) = y_of(c%pair(1, k)) - y_of(c%pair(2, k))
+    end do
+  contains
+    subroutine add_incidence(a, b, v)
+      integer, intent(in) :: a, b
+      real(dp), intent(in) :: v
+      if (a > 0 .and. b > 0) l(a, b) = l(a, b) + v
+    end subroutine add_incidence
+    function y_of(body) result(v)
+      integer, intent(in) :: body
+      real(dp) :: v(3)
+      v = 0
+      if (body > 0) then
+        if (row(body) > 0) v = y(row(body), :)
+      end if
+    end function y_of
+  end subroutine start_carry
 
   !> The contact force on the constraint's node: normal and friction
   pure function node_force(c, a) result(f)

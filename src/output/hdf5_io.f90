@@ -333,7 +333,7 @@ contains
   !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
   !> have any size, including 0.
   subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
-                              checksum)
+                              checksum, dt_cap)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
@@ -344,6 +344,7 @@ contains
     integer, intent(in), optional :: fingerprint(:)
     real(dp), intent(in), optional :: dt_next   !< the next step's length (error-controlled runs)
     integer, intent(in), optional :: checksum(:)
+    real(dp), intent(in), optional :: dt_cap(:) !< the energy's cap on the steps and when set (idem)
 
     character(len=*), parameter :: who = 'write_checkpoint'
     integer(hid_t) :: fid
@@ -374,14 +375,16 @@ contains
       call put_real_scalar(who, path, fid, 'dt_next', dt_next, err)
     if (present(checksum) .and. .not. allocated(err)) &
       call put_int_1d(who, path, fid, 'checksum', checksum, err)
+    if (present(dt_cap) .and. .not. allocated(err)) &
+      call put_real_1d(who, path, fid, 'dt_cap', dt_cap, err)
     if (.not. allocated(err)) call save_image(who, path, fid, err)
     call h5fclose_f(fid, h)   ! (in memory: nothing to fail on)
   end subroutine write_checkpoint
 
   !> Read a checkpoint written by write_checkpoint (fingerprint, checksum: not allocated if it
-  !> has none; dt_next: 0 if it has none).
+  !> has none; dt_next: 0 if it has none; dt_cap: not allocated if it has none).
   subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
-                             checksum)
+                             checksum, dt_cap)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
@@ -392,6 +395,7 @@ contains
     integer, allocatable, intent(out), optional :: fingerprint(:)
     real(dp), intent(out), optional :: dt_next
     integer, allocatable, intent(out), optional :: checksum(:)
+    real(dp), allocatable, intent(out), optional :: dt_cap(:)
 
     character(len=*), parameter :: who = 'read_checkpoint'
     integer(hid_t) :: fid
@@ -424,6 +428,10 @@ contains
         call h5lexists_f(fid, 'dt_next', has_dt, h)
         if (h == 0 .and. has_dt) call get_real_scalar(who, path, fid, 'dt_next', dt_next, err)
       end if
+    end if
+    if (present(dt_cap) .and. .not. allocated(err)) then
+      call h5lexists_f(fid, 'dt_cap', has_dt, h)
+      if (h == 0 .and. has_dt) call get_real_1d(who, path, fid, 'dt_cap', dt_cap, err)
     end if
     call h5fclose_f(fid, h)
     if (allocated(err)) return

@@ -297,19 +297,28 @@ contains
       d = deck%contact%friction; st = deck%contact%static_friction
       t = c%pair(2, p)
       if (t < 0) then
-        if (deck%obstacles(-t)%friction /= unset) d = deck%obstacles(-t)%friction
-        if (deck%obstacles(-t)%static_friction /= unset) st = deck%obstacles(-t)%static_friction
+        call own(deck%obstacles(-t)%friction, deck%obstacles(-t)%static_friction)
       else
         do j = 1, deck%contact%npairs
           if (.not. same_bodies(deck%contact%pairs(:, j), c%pair(1, p), t)) cycle
-          if (deck%contact%pair_friction(j) /= unset) d = deck%contact%pair_friction(j)
-          if (deck%contact%pair_static_friction(j) /= unset) st = deck%contact%pair_static_friction(j)
+          call own(deck%contact%pair_friction(j), deck%contact%pair_static_friction(j))
         end do
       end if
       c%mu_d(p) = d
       c%mu_s(p) = merge(st, d, st /= unset)
     end do
   contains
+    !> A pair's or obstacle's own coefficients replace &contact's; its own dynamic one alone
+    !> is its static one too (&contact's static one could be below it: a plate on a slope
+    !> crept by stick-slip where it should have held)
+    subroutine own(dyn, sta)
+      real(dp), intent(in) :: dyn, sta
+      if (dyn /= unset) then
+        d = dyn; st = unset
+      end if
+      if (sta /= unset) st = sta
+    end subroutine own
+
     !> the two names are bodies a and b, either way round
     logical function same_bodies(names, a, b)
       character(len=*), intent(in) :: names(2)

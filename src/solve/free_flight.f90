@@ -43,12 +43,13 @@ contains
   end subroutine idle_bodies
 
   !> Clear far(b) of the bodies in contact, or with an impactor node that could reach its
-  !> target within two steps of dt
-  subroutine clear_near_contact(model, q, qd, dt, contact, far)
+  !> target within two steps of dt; near_pair (per pair): the pairs that make them so
+  subroutine clear_near_contact(model, q, qd, dt, contact, far, near_pair)
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:), qd(:), dt
     type(contact_t), intent(in) :: contact
     logical, intent(inout) :: far(:)
+    logical, intent(out), optional :: near_pair(:)
     real(dp) :: lo(3, model%nbody), hi(3, model%nbody), speed(model%nbody), reach, x(3), nrm(3), d
     logical :: near
     integer :: b, n, k, i, j
@@ -60,19 +61,26 @@ contains
         speed(b) = max(speed(b), norm2(qd(dof(n, 1):dof(n, 3))))
       end do
     end do
+    if (present(near_pair)) near_pair = .false.
     do k = 1, contact%nact   ! bodies in contact
       i = model%node_body(contact%act(k)%node)
       far(i) = .false.
       j = contact%pair(2, contact%act(k)%pair)
       if (j > 0) far(j) = .false.
+      if (present(near_pair)) near_pair(contact%act(k)%pair) = .true.
     end do
     do k = 1, contact%npairs  ! an impactor node that could reach the target within two steps
       i = contact%pair(1, k); j = contact%pair(2, k)
-      if (j > 0) then
+      if (present(near_pair)) then
+        if (near_pair(k)) cycle
+      else if (j > 0) then
         if (.not. (far(i) .or. far(j))) cycle
-        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + face_reach(contact, model, i, j)
       else
         if (.not. far(i)) cycle
+      end if
+      if (j > 0) then
+        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + face_reach(contact, model, i, j)
+      else
         reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%tol + &
                 face_reach(contact, model, i, j)
       end if
@@ -87,6 +95,7 @@ contains
         if (near) then
           far(i) = .false.
           if (j > 0) far(j) = .false.
+          if (present(near_pair)) near_pair(k) = .true.
           exit
         end if
       end do
