@@ -36,7 +36,7 @@ module casca_contact
     real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)
     !> the gap's derivative on the fibres: wg(1) n.dG at the node, wg(2) sum_j N_j n.dG_j
     real(dp) :: wg(2) = 0
-    !> which face (+-1 on the fibre; 2: an edge) of the impactor node and of the target is in
+    !> which face (+-1 on the fibre) of the impactor node and of the target is in
     !> contact, chosen when the constraint is made (0: not yet)
     integer :: face(2) = 0
     real(dp) :: sd = 0          !< signed distance to the sub-triangles when last projected

@@ -270,15 +270,17 @@ contains
 
   !> Distance f along u of face s of a shell, (h/2) s G.u (along the current fibre, at the
   !> reference thickness), and w = (h/2) s, its derivative along -u.dG (the sign the gap
-  !> takes for the face towards u). s = 0 (a new constraint) chooses, then holds: the face
-  !> towards u, or, for a node on its shell's free edge (rim) whose fibre is more than 60
-  !> degrees from u, s = 2, an edge (a strip meeting a wall edge-on: f = 0 and no moment on
-  !> its fibre, since the pressure spreads over the edge's thickness). A node inside a shell
-  !> has no edge: its face's offset (h/2)|G.u| goes smoothly to 0 as the fibre turns across
-  !> u. (Choosing an edge there too made the offset jump by h/4 or more when a released
-  !> constraint was taken again with its fibre back within 60 degrees: the node started 1.5
-  !> mm inside a steel sphere and was pushed out in one step, a rubber ball's impact making
-  !> 19% of its energy. rim absent: the target's side, an edge allowed.)
+  !> takes for the face towards u). s = 0 (a new constraint) chooses, then holds, the face
+  !> towards u. Where the shell may touch with its edge (rim: a node on its shell's free
+  !> edge; rim absent: the target's side) the offset fades to 0 as the fibre turns across u:
+  !> f = (h/2) s k phi(|k|/|G|), k = G.u, phi a smoothstep from 0 at |k| = 0.25 |G| (75
+  !> degrees) to 1 at 0.5 |G| (60 degrees), so that a strip meeting a wall edge-on has no
+  !> offset and no moment on its fibre (the pressure spreads over the edge's thickness), and
+  !> the offset has no jump anywhere. (Until 2026-11-27 an edge was chosen past 60 degrees,
+  !> with offset 0 against the face's h/4 there: a blade landing at 60 degrees, its fibres
+  !> shaking across that angle, had nodes found at the edge's gap and taken again at the
+  !> face's, h/4 deep, and pushed out in one step: 16 times E0. A node inside a shell lost
+  !> 19% of a rubber ball's E0 the same way, and has no edge: phi = 1.)
   !> (The element's face, (h/2)(s + a) G, moves with the thickness parameter a too; but a
   !> has no mass and follows the contact force within a step, and fed back through the
   !> offset it made the trapezoidal rule unstable: a ring on a floor had a grow from 3e-4 to
@@ -288,19 +290,22 @@ contains
     integer, intent(inout) :: s
     real(dp), intent(out) :: f, w
     logical, intent(in), optional :: rim
-    real(dp) :: k
+    real(dp), parameter :: r1 = 0.25_dp, r2 = 0.5_dp
+    real(dp) :: k, r, t, phi, dphi
     logical :: edge_ok
     edge_ok = .true.
     if (present(rim)) edge_ok = rim
     k = dot_product(g, u)
-    if (s == 0) then
-      s = merge(1, -1, k >= 0)
-      if (edge_ok .and. abs(k) < 0.5_dp*norm2(g)) s = 2
+    if (s == 0 .or. s == 2) s = merge(1, -1, k >= 0)   ! (2: an edge, in older checkpoints)
+    phi = 1; dphi = 0
+    if (edge_ok) then
+      r = abs(k)/max(norm2(g), tiny(1._dp))
+      t = min(1._dp, max(0._dp, (r - r1)/(r2 - r1)))
+      phi = t*t*(3 - 2*t)
+      dphi = r*6*t*(1 - t)/(r2 - r1)   ! r phi'(r): d(k phi(|k|))/dk = phi + r phi'
     end if
-    f = 0; w = 0
-    if (s == 2) return
-    f = 0.5_dp*h*s*k
-    w = 0.5_dp*h*s
+    f = 0.5_dp*h*s*k*phi
+    w = 0.5_dp*h*s*(phi + dphi)
   end subroutine face
 
   !> The nodes a constraint acts on and the weights of its row of C: n on the impactor node,
