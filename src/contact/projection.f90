@@ -273,10 +273,14 @@ contains
   !> takes for the face towards u). s = 0 (a new constraint) chooses, then holds, the face
   !> towards u. Where the shell may touch with its edge (rim: a node on its shell's free
   !> edge; rim absent: the target's side) the offset fades to 0 as the fibre turns across u:
-  !> f = (h/2) s k phi(|k|/|G|), k = G.u, phi a smoothstep from 0 at |k| = 0.25 |G| (75
-  !> degrees) to 1 at 0.5 |G| (60 degrees), so that a strip meeting a wall edge-on has no
-  !> offset and no moment on its fibre (the pressure spreads over the edge's thickness), and
-  !> the offset has no jump anywhere. (Until 2026-11-27 an edge was chosen past 60 degrees,
+  !> f = (h/2) s k phi(|k|), k = G.u, phi a smoothstep from 0 at |k| = 0.25 (75 degrees, G
+  !> being of about unit length) to 1 at 0.5 (60 degrees), so that a strip meeting a wall
+  !> edge-on has no offset and no moment on its fibre (the pressure spreads over the edge's
+  !> thickness), and the offset has no jump anywhere. f depends on G through k alone, so w
+  !> is its whole derivative (phi of |k|/|G| left G's stretch out of the row: a thick blade
+  !> landing at 62 degrees on a rigid plane gained 2.5% of E0 through its contact, now
+  !> 1e-11; thick shells in contact within this band still gain up to a few 10% of E0 on
+  !> some scenes, docs/performance.md "Fifteenth session"). (Until 2026-11-27 an edge was chosen past 60 degrees,
   !> with offset 0 against the face's h/4 there: a blade landing at 60 degrees, its fibres
   !> shaking across that angle, had nodes found at the edge's gap and taken again at the
   !> face's, h/4 deep, and pushed out in one step: 16 times E0. A node inside a shell lost
@@ -299,7 +303,7 @@ contains
     if (s == 0 .or. s == 2) s = merge(1, -1, k >= 0)   ! (2: an edge, in older checkpoints)
     phi = 1; dphi = 0
     if (edge_ok) then
-      r = abs(k)/max(norm2(g), tiny(1._dp))
+      r = abs(k)
       t = min(1._dp, max(0._dp, (r - r1)/(r2 - r1)))
       phi = t*t*(3 - 2*t)
       dphi = r*6*t*(1 - t)/(r2 - r1)   ! r phi'(r): d(k phi(|k|))/dk = phi + r phi'
