@@ -229,7 +229,7 @@ contains
       if (failed(r, 'setup')) return
       if (deck%run%ordering == 'metis') r%ls%solver%ordering = 1
       r%ls%solver%single = deck%run%factor_precision == 'single'   ! (K only: M stays double)
-      r%opts%tol = default_newton_tol   ! (with a tolerance on the steps: dynamic_start)
+      r%opts%tol = default_newton_tol
       if (deck%run%newton_tol /= unset) r%opts%tol = deck%run%newton_tol
       r%opts%max_iter = deck%run%newton_max_iter
       r%opts%reuse = deck%run%reuse_factorisation
@@ -721,8 +721,7 @@ contains
     type(run_t), intent(inout) :: r
     logical :: falls(r%model%nbody), falling(r%model%nbody), ground(r%model%nbody)
     logical, allocatable :: near(:)
-    real(dp) :: share(3, r%model%nbody)
-    integer :: b, n, e
+    integer :: b, n
     associate (model => r%model, st => r%st)
       do b = 1, model%nbody
         associate (bd => model%body(b))
@@ -735,17 +734,8 @@ contains
         allocate (near(r%contact%npairs))
         call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls, near)
         r%held_at_start = any(falling .and. .not. falls)
-        if (r%held_at_start) then
-          ! what their contacts hold: each held body's weight, M g on its positions
-          share = 0
-          do b = 1, model%nbody
-            if (.not. (falling(b) .and. .not. falls(b))) cycle
-            do e = model%body(b)%elem_first, model%body(b)%elem_last
-              share(:, b) = share(:, b) - model%body(b)%gravity*sum(model%emass(1:10, 1:10, e))
-            end do
-          end do
-          call start_carry(r%contact, near, share, ground)
-        end if
+        if (r%held_at_start) call start_carry(r%contact, near, &
+                                              -weights(model, falling .and. .not. falls), ground)
       end if
       do b = 1, model%nbody
         if (.not. falls(b)) cycle
@@ -755,6 +745,22 @@ contains
       end do
     end associate
   end subroutine start_acceleration
+
+  !> (3, nbody): the weight of each body of which, M g on its positions (the consistent mass's
+  !> Y-Y entries summed, the momentum's metric), 0 for the others
+  pure function weights(model, which) result(w)
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: which(:)
+    real(dp) :: w(3, model%nbody)
+    integer :: b, e
+    w = 0
+    do b = 1, model%nbody
+      if (.not. which(b)) cycle
+      do e = model%body(b)%elem_first, model%body(b)%elem_last
+        w(:, b) = w(:, b) + model%body(b)%gravity*sum(model%emass(1:10, 1:10, e))
+      end do
+    end do
+  end function weights
 
   !> the output folder and files; the history's per-body and per-pair columns are named
   !> after the bodies and obstacles (targets -k: names from -size(obstacles) up)
