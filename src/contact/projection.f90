@@ -279,12 +279,12 @@ contains
   !> thickness), and the offset has no jump anywhere. f depends on G through k alone, so w
   !> is its whole derivative (phi of |k|/|G| left G's stretch out of the row: a thick blade
   !> landing at 62 degrees on a rigid plane gained 2.5% of E0 through its contact, now
-  !> 1e-11; thick shells in contact within this band still gain up to a few 10% of E0 on
-  !> some scenes, docs/performance.md "Fifteenth session"). (Until 2026-11-27 an edge was chosen past 60 degrees,
-  !> with offset 0 against the face's h/4 there: a blade landing at 60 degrees, its fibres
-  !> shaking across that angle, had nodes found at the edge's gap and taken again at the
-  !> face's, h/4 deep, and pushed out in one step: 16 times E0. A node inside a shell lost
-  !> 19% of a rubber ball's E0 the same way, and has no edge: phi = 1.)
+  !> 1e-11; thick shells against a body within this band still gain up to a few 10% of E0
+  !> on some scenes, docs/performance.md "Fifteenth session"). (Until 2026-11-27 an edge was
+  !> chosen past 60 degrees, with offset 0 against the face's h/4 there: a blade landing at
+  !> 60 degrees, its fibres shaking across that angle, had nodes found at the edge's gap and
+  !> taken again at the face's, h/4 deep, and pushed out in one step: 16 times E0. A node
+  !> inside a shell lost 19% of a rubber ball's E0 the same way, and has no edge: phi = 1.)
   !> (The element's face, (h/2)(s + a) G, moves with the thickness parameter a too; but a
   !> has no mass and follows the contact force within a step, and fed back through the
   !> offset it made the trapezoidal rule unstable: a ring on a floor had a grow from 3e-4 to

@@ -216,6 +216,7 @@ contains
     type(run_t), intent(inout) :: r
     character(len=*), intent(in) :: path, out_dir
     integer :: k
+    real(dp) :: cap(2)   !< the energy's cap on the steps, from a checkpoint
     character(len=300), allocatable :: far(:)
     call load_scene(path, r%deck, r%model, r%code)
     if (r%code /= exit_ok) return
@@ -253,8 +254,9 @@ contains
       if (r%restart /= '') then   ! (statics: t is the load factor, <= 1)
         call load_checkpoint(r%restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
                              'static'), deck%run%max_step_cuts, r%st, r%level, r%err, r%contact, &
-                             r%dt_try, r%dt_cap, r%cap_since)
+                             r%dt_try, cap)
         if (failed(r, 'restart')) return
+        r%dt_cap = cap(1); r%cap_since = cap(2)
         r%restart_step = r%st%step
       end if
     end associate
@@ -719,7 +721,7 @@ contains
   !> under a point load.)
   subroutine start_acceleration(r)
     type(run_t), intent(inout) :: r
-    logical :: falls(r%model%nbody), falling(r%model%nbody), ground(r%model%nbody)
+    logical :: falls(r%model%nbody), held(r%model%nbody), ground(r%model%nbody)
     logical, allocatable :: near(:)
     integer :: b, n
     associate (model => r%model, st => r%st)
@@ -730,12 +732,12 @@ contains
         end associate
       end do
       if (allocated(r%contact)) then
-        falling = falls
+        held = falls
         allocate (near(r%contact%npairs))
         call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls, near)
-        r%held_at_start = any(falling .and. .not. falls)
-        if (r%held_at_start) call start_carry(r%contact, near, &
-                                              -weights(model, falling .and. .not. falls), ground)
+        held = held .and. .not. falls   ! (under gravity, free, but near a contact)
+        r%held_at_start = any(held)
+        if (r%held_at_start) call start_carry(r%contact, near, -weights(model, held), ground)
       end if
       do b = 1, model%nbody
         if (.not. falls(b)) cycle
@@ -869,7 +871,7 @@ contains
     call r%ls%drop_factors()
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
     if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e, &
-                                                  r%dt_try, r%dt_cap, r%cap_since)
+                                                  r%dt_try, [r%dt_cap, r%cap_since])
     call share_error(e)
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message
@@ -994,7 +996,7 @@ contains
   !> nonlinear one)
   subroutine warn_energy(r)
     type(run_t), intent(in) :: r
-    character(len=:), allocatable :: made, why
+    character(len=:), allocatable :: made, why, shorter
     real(dp) :: e0, tc
     integer :: b
     e0 = abs(r%bal0%total)
@@ -1011,8 +1013,9 @@ contains
     end if
     ! (under a tolerance the steps in contact are the error estimate's, which leaves the
     ! contact nodes out: two balls head-on made 0.24% in a 100 us step at 1e-3)
-    why = why//'; look at the frames there, or take '//trim(merge('a smaller tolerance', &
-                                                                  'a shorter dt       ', r%sc%tol > 0))
+    shorter = 'a shorter dt'
+    if (r%sc%tol > 0) shorter = 'a smaller tolerance'
+    why = why//'; look at the frames there, or take '//shorter
     ! (an 80-degree plate landing edge-first under the trapezoidal rule: 0.72% of E0, the same
     ! between mid-surfaces, no node edge-on or deep)
     if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) why = why//'; or the impact''s ringing, '// &
@@ -1032,8 +1035,7 @@ contains
         tc = contact_time(r%deck, r%model, b)
         why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &
               rtoa(tc/r%dt_made)//' steps of that step ('//rtoa(r%dt_made)//' s) for body '''// &
-              trim(r%model%body(b)%name)//'''; take '//trim(merge('a smaller tolerance', &
-              'a shorter dt       ', r%sc%tol > 0))//' or a lower stiffness'
+              trim(r%model%body(b)%name)//'''; take '//shorter//' or a lower stiffness'
       end if
     end if
     write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &

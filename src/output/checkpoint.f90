@@ -70,7 +70,7 @@ contains
 
   !> Write the checkpoint path (rank 0; the caller shares err): refused if the state or the
   !> multipliers are not finite.
-  subroutine save_checkpoint(path, model, st, level, contact, err, dt_next, dt_cap, cap_since)
+  subroutine save_checkpoint(path, model, st, level, contact, err, dt_next, cap)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
@@ -78,8 +78,8 @@ contains
     type(contact_t), intent(in), optional :: contact
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)
-    real(dp), intent(in), optional :: dt_cap    !< and the energy's cap on it (huge: none), ...
-    real(dp), intent(in), optional :: cap_since !< ... set or last doubled at this time
+    !> and the energy's cap on it (huge: none) and when it was set or last doubled
+    real(dp), intent(in), optional :: cap(2)
     integer, allocatable :: ints(:)
     real(dp), allocatable :: reals(:)
     integer :: k, nact
@@ -117,21 +117,14 @@ contains
       ints = [level, 0]
       allocate (reals(0))
     end if
-    if (present(dt_cap) .and. present(cap_since)) then
-      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
-                            model_fingerprint(model), dt_next, state_checksum(st, ints, reals), &
-                            [dt_cap, cap_since])
-    else
-      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
-                            model_fingerprint(model), dt_next, state_checksum(st, ints, reals))
-    end if
+    call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
+                          model_fingerprint(model), dt_next, state_checksum(st, ints, reals), cap)
   end subroutine save_checkpoint
 
   !> Read the checkpoint path into st, level and the contact active set, after checking that
   !> it belongs to this model and that every field is in range: 0 <= t <= t_max, step >= 0,
   !> 0 <= level <= max_level, each constraint an impactor node of one of the contact pairs.
-  subroutine load_checkpoint(path, model, t_max, max_level, st, level, err, contact, dt_next, dt_cap, &
-                             cap_since)
+  subroutine load_checkpoint(path, model, t_max, max_level, st, level, err, contact, dt_next, cap)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: t_max
@@ -141,8 +134,7 @@ contains
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
     real(dp), intent(out), optional :: dt_next   !< 0: not in the checkpoint
-    real(dp), intent(out), optional :: dt_cap    !< huge: not in the checkpoint
-    real(dp), intent(out), optional :: cap_since
+    real(dp), intent(out), optional :: cap(2)    !< [huge, 0]: not in the checkpoint
     integer, allocatable :: ints(:), fp(:), cs(:)
     real(dp), allocatable :: cp(:)   ! (the energy's cap and when it was set)
     real(dp), allocatable :: reals(:)
@@ -176,16 +168,14 @@ contains
     if (bad == '' .and. present(dt_next)) then
       if (.not. (dt_next >= 0 .and. dt_next <= t_max)) bad = 'its next step is outside [0, t_end]'
     end if
-    if (present(dt_cap)) dt_cap = huge(1._dp)
-    if (present(cap_since)) cap_since = 0
+    if (present(cap)) cap = [huge(1._dp), 0._dp]
     if (bad == '' .and. allocated(cp)) then
       if (size(cp) /= 2) then
         bad = 'its cap on the steps has '//itoa(size(cp))//' numbers, not 2'
       else if (.not. (cp(1) > 0 .and. cp(2) >= 0 .and. cp(2) <= t_max)) then
         bad = 'its cap on the steps is not positive or was set outside [0, t_end]'
-      else
-        if (present(dt_cap)) dt_cap = cp(1)
-        if (present(cap_since)) cap_since = cp(2)
+      else if (present(cap)) then
+        cap = cp
       end if
     end if
     if (bad == '') then
