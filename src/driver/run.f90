@@ -11,6 +11,7 @@ module casca_run
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
   use casca_mass_solver, only: mass_setup
+  use casca_start_acceleration, only: loaded_acceleration
   use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_step
   use casca_statics, only: static_solve
@@ -287,6 +288,7 @@ contains
     !> surfaces); energy_cut: this step was cut for its energy once already (a half step that
     !> makes energy too is kept: a shorter one made more on a plane pushing a ring)
     logical :: guarded, energy_cut
+    character(len=:), allocatable :: why
     call dynamic_start(r, interval, next_frame, next_ckpt)
     if (r%code /= exit_ok) return
     associate (deck => r%deck, model => r%model, st => r%st, nm => r%nm, rep => r%rep)
@@ -336,9 +338,10 @@ contains
         end if
         if (guarded .and. .not. energy_cut .and. step_judged(r) .and. &
             made > made_limit*energy_scale() .and. may_cut()) then
-          call undo_step()
-          call cut_step('the step made '//ftoa(100*made/energy_scale())//'% of the energy the '// &
-                        'bodies hold (a node deep into a target, or a mode the step cannot follow)')
+          why = 'the step made '//ftoa(100*made/energy_scale())//'% of the energy the '// &
+                'bodies hold (a node deep into a target, or a mode the step cannot follow)'
+          call undo_step()   ! (after the share: undone, the step's end is its start)
+          call cut_step(why)
           energy_cut = .true.
           cycle
         end if
@@ -433,6 +436,7 @@ contains
         next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
       if (r%restart_step < 0) then
         call start_acceleration(r)
+        if (failed(r, 'start acceleration')) return
         call account_state(r)
         r%bal0 = r%bal
         call watch_energy(r, rest_now(r))
@@ -712,30 +716,34 @@ contains
     if (use_contact .and. r%deck%run%analysis /= 'static') call mass_setup(r%model, r%ls%mass, r%err)
   end subroutine setup_contact
 
-  !> Gravity's acceleration at the start, the body's g on every point of a free body clear of contact
-  !> (restrained or resting bodies start at rest, a = 0: their supports hold them, and the
-  !> resting ones' contacts carry their weight from the start: start_carry). With 0
-  !> for a falling body the first step would change its momentum by (gamma - 1/2) m g dt
-  !> too much (thesis Newmark: 3e-5 of a bouncing ring's momentum change). (Not M^-1 f for
-  !> nodal loads: concentrated at the loaded nodes, it made Newton diverge on a thin strip
-  !> under a point load.)
+  !> The acceleration at the start: the body's g on every point of a free body clear of
+  !> contact under gravity alone, the equation of motion's M^-1 (F - f_int - f_p) on a body
+  !> clear of contact that carries a load (casca_start_acceleration). Bodies near a contact
+  !> start at a = 0: under gravity their contacts carry their weight from the start
+  !> (start_carry). With 0 for a falling body the first step would change its momentum by
+  !> (gamma - 1/2) m g dt too much (thesis Newmark: 3e-5 of a bouncing ring's momentum
+  !> change).
   subroutine start_acceleration(r)
     type(run_t), intent(inout) :: r
-    logical :: falls(r%model%nbody), held(r%model%nbody), ground(r%model%nbody)
-    logical, allocatable :: near(:)
+    logical :: falls(r%model%nbody), held(r%model%nbody), ground(r%model%nbody), loaded(r%model%nbody)
+    logical, allocatable :: near(:), moves(:)
     integer :: b, n
     associate (model => r%model, st => r%st)
       do b = 1, model%nbody
         associate (bd => model%body(b))
           ground(b) = any(model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7)))
           falls(b) = any(bd%gravity /= 0) .and. .not. ground(b)
+          loaded(b) = any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0) .or. &
+                      any(model%pressure /= 0 .and. model%elem_body == b)
         end associate
       end do
       if (allocated(r%contact)) then
-        held = falls
+        moves = falls .or. loaded
         allocate (near(r%contact%npairs))
-        call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, falls, near)
-        held = held .and. .not. falls   ! (under gravity, free, but near a contact)
+        call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, moves, near)
+        held = falls .and. .not. moves   ! (under gravity, free, but near a contact)
+        falls = falls .and. moves
+        loaded = loaded .and. moves
         r%held_at_start = any(held)
         if (r%held_at_start) call start_carry(r%contact, near, -weights(model, held), ground)
       end if
@@ -745,6 +753,12 @@ contains
           st%qdd(dof(n, 1):dof(n, 3)) = model%body(b)%gravity
         end do
       end do
+      if (.not. any(loaded)) return
+      if (allocated(r%contact)) then
+        call loaded_acceleration(model, r%asm, st%q, r%fext, loaded, st%qdd, r%err, r%ls%mass)
+      else
+        call loaded_acceleration(model, r%asm, st%q, r%fext, loaded, st%qdd, r%err)
+      end if
     end associate
   end subroutine start_acceleration
 

@@ -37,6 +37,7 @@ module casca_mass_solver
     type(column_cache_t) :: cache(3)     !< per system
   contains
     procedure :: columns => mass_columns
+    procedure :: solve => mass_solve
     procedure :: finish => mass_finish
   end type mass_solver_t
 
@@ -126,6 +127,28 @@ contains
       end do
     end associate
   end subroutine mass_columns
+
+  !> a = M^-1 f on the free Y, G parameters (0 on the others): the acceleration a dense load
+  !> gives (the start's; once per run, so no cache)
+  subroutine mass_solve(self, f, a, err)
+    class(mass_solver_t), intent(inout) :: self
+    real(dp), intent(in) :: f(:)
+    real(dp), intent(out) :: a(:)
+    type(error_t), allocatable, intent(out) :: err
+    real(dp), allocatable :: b(:, :), x(:, :)
+    integer :: c, n
+    a = 0
+    do c = 1, 3
+      n = self%neq(c)
+      if (n == 0) cycle
+      b = reshape(f(self%dofs(1:n, c)), [n, 1])
+      if (allocated(x)) deallocate (x)
+      allocate (x(n, 1))
+      call self%m(self%solver_of(c))%solve(b, x, err)
+      if (allocated(err)) return
+      a(self%dofs(1:n, c)) = x(:, 1)
+    end do
+  end subroutine mass_solve
 
   !> Make sure the cache of system s holds M^-1 e_i for every equation i in idx (a full
   !> cache is emptied, not grown: the equations asked for now are solved again)

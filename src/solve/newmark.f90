@@ -116,7 +116,9 @@ contains
       real(dp) :: cm
       allocate (qs(size(st%q)))
       call nm%inertia(st%q, st%qd, a0, cm, qs)
-      if (.not. warm) call nm%predictor(st%q, st%qd, a0, q)
+      ! (the first step's start acceleration is M^-1 F of the loads, spiky under a point
+      ! load: predicted from, it failed Newton's first step on a thin strip)
+      if (.not. warm) call nm%predictor(st%q, st%qd, merge(a0, 0*a0, st%step > 0), q)
       where (model%fixed) q = st%q
       call newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, st%q, nm%alpha_f)
       if (.not. allocated(err) .and. .not. rep%converged) &
