@@ -191,6 +191,12 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("unknown group", lambda s: s.replace("&output", "&outptu"), ["&outptu", ":4:"]),
     ("misspelt key", lambda s: s.replace("velocity", "velocty"), ["velocty", "velocity", ":11:"]),
     ("wrong type", lambda s: s.replace("dt = 5.0e-5", "dt = 'fast'"), ["dt", "not a number", ":2:"]),
+    ("a key given twice", lambda s: s.replace("  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n",
+                                              "  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n"
+                                              "  thickness = 0.025\n", 1),
+     ["&body", "thickness is given twice (lines 12 and 13)", "keep one", ":13:"]),
+    ("a vector short of a number", lambda s: s.replace("velocity = 10.0, 0.0, 0.0", "velocity = 10.0, 0.0", 1),
+     ["&body", "velocity takes 3 numbers (x, y, z), 2 given", ":11:"]),
     ("E not positive", lambda s: s.replace("young = 210e9", "young = -1.0", 1), ["young", "> 0"]),
     ("rho not positive", lambda s: s.replace("density = 7700", "density = 0.0", 1), ["density", "> 0"]),
     ("thickness not positive", lambda s: s.replace("thickness = 0.05", "thickness = 0.0", 1), ["thickness", "> 0"]),

@@ -55,6 +55,10 @@ module casca_deck_lint
     key_t('obstacle', 'velocity', 'r'), key_t('obstacle', 'friction', 'r'), &
     key_t('obstacle', 'static_friction', 'r'), key_t('obstacle', 'inside', 'l')]
 
+  !> The keys that are vectors of three, in every group they belong to
+  character(len=11), parameter :: vec3(*) = [character(len=11) :: 'gravity', 'rotate_axis', &
+    'center', 'velocity', 'omega', 'box_min', 'box_max', 'force', 'point', 'normal', 'axis']
+
 contains
 
   !> Type of key in group: 'r' real, 'i' integer, 'l' logical, 's' string, ' ' unknown.
@@ -83,6 +87,10 @@ contains
     integer :: i, j, k, n, p
     character(len=1) :: t, q
     logical :: done
+    character(len=20), allocatable :: seen(:)   !< the keys given so far, and their lines
+    integer, allocatable :: seen_line(:)
+    integer :: nval, key_line
+    logical :: indexed
 
     ! the group as one string (comments cut), with the line of each character
     allocate (lines(0), msgs(0))
@@ -110,12 +118,15 @@ contains
     n = len(s)
     p = index(s, '&') + 1 + len_trim(group)
     key = ''; t = ' '
+    allocate (seen(0), seen_line(0))
+    nval = 0; key_line = 0; indexed = .false.
     done = .false.
     do while (p <= n .and. .not. done)
       select case (s(p:p))
       case (' ', ',', achar(9))
         p = p + 1
       case ('/')
+        call key_done()
         done = .true.
       case ("'", '"')
         q = s(p:p)
@@ -136,11 +147,15 @@ contains
           k = k + 1
         end do
         if (k <= n .and. s(k:k) == '=') then   ! a key
+          call key_done()
           key = lower(item)
-          if (index(key, '(') > 0) key = key(1:index(key, '(') - 1)
+          indexed = index(key, '(') > 0
+          if (indexed) key = key(1:index(key, '(') - 1)
           t = key_type(group, key)
           if (t == ' ') call report(lineof(p), '&'//group//': unknown key '''//key//''''// &
                                     suggestion(group, key))
+          key_line = lineof(p); nval = 0
+          if (t /= ' ' .and. .not. indexed) call once()
           p = k + 1
         else
           call value(item, lineof(p))
@@ -158,8 +173,13 @@ contains
       logical :: lv
       if (key == '' .or. t == ' ') return
       w = v
+      nval = nval + 1
       star = index(w, '*')   ! repeat count r*value
-      if (star > 0 .and. verify(w(1:max(star - 1, 1)), '0123456789') == 0) w = w(star + 1:)
+      if (star > 0 .and. verify(w(1:max(star - 1, 1)), '0123456789') == 0) then
+        read (w(1:star - 1), *, iostat=ios) iv
+        if (ios == 0) nval = nval - 1 + iv
+        w = w(star + 1:)
+      end if
       if (len(w) == 0) return
       ios = 0
       select case (t)
@@ -188,6 +208,33 @@ contains
       end select
       if (ios /= 0) call report(line, '&'//group//': '//key//' = '//w//' is not '//kind_name(t))
     end subroutine value
+
+    !> A key given twice in a group: Fortran's read keeps the last silently (a deck with two
+    !> thickness lines ran with the second)
+    subroutine once()
+      integer :: m
+      do m = 1, size(seen)
+        if (seen(m) /= key) cycle
+        if (seen_line(m) == key_line) then
+          call report(key_line, '&'//group//': '//key//' is given twice on this line: keep one')
+        else
+          call report(key_line, '&'//group//': '//key//' is given twice (lines '//itoa(seen_line(m))// &
+                      ' and '//itoa(key_line)//'): keep one')
+        end if
+        return
+      end do
+      seen = [character(len=20) :: seen, key]
+      seen_line = [seen_line, key_line]
+    end subroutine once
+
+    !> The key just read is complete: a vector of three takes three numbers (the read fills
+    !> what is missing from the default and drops nothing: velocity = 1.0, 2.0 ran with vz 0)
+    subroutine key_done()
+      if (key == '' .or. t /= 'r' .or. indexed) return
+      if (all(key /= vec3)) return
+      if (nval /= 3) call report(key_line, '&'//group//': '//key//' takes 3 numbers (x, y, z), '// &
+                                 itoa(nval)//' given')
+    end subroutine key_done
 
     subroutine report(line, msg)
       integer, intent(in) :: line
