@@ -47,15 +47,7 @@ contains
         end if
       end if
       if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
-        ! between faces the point is where the faces' points lie on one normal (lever in
-        ! constraint_geometry): near the projection of the node's face point, which may be
-        ! on another element than the node's own
-        found = .false.
-        if (c%faces .and. c%act(k)%wg(1) /= 0) then
-          n = c%act(k)%node
-          call project(c, model, x, n, c%act(k)%pair, cn, found, x(:, n) + c%act(k)%wg(1)*q(dof(n, 4):dof(n, 6)))
-        end if
-        if (.not. found) call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
+        call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
         if (found) then
           c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd
         end if   ! (else far from every sub-triangle within reach: keep the last point)

@@ -70,19 +70,16 @@ contains
   !> The target point of node on the body target of pair p (nearest sub-triangle within the
   !> pair's search radius): con%elem, con%xi, con%sd (signed distance to the sub-triangle,
   !> positive on its normal's side). ok = .false. when nothing is within reach.
-  subroutine project(c, model, x, node, p, con, ok, at)
+  subroutine project(c, model, x, node, p, con, ok)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: x(:, :)
     integer, intent(in) :: node, p
     type(constraint_t), intent(out) :: con
     logical, intent(out) :: ok
-    real(dp), intent(in), optional :: at(3)   !< the point projected instead of the node's
     integer :: bi, bt, itri, region
-    real(dp) :: xq(3), bary(3), dist, nt(3), near(3, 2), r, xn(3)
+    real(dp) :: xq(3), bary(3), dist, nt(3), near(3, 2), r
     bi = c%pair(1, p); bt = c%pair(2, p)
-    xn = x(:, node)
-    if (present(at)) xn = at
     r = search_radius(c, model, bi, bt)
     associate (g => c%geo)
       if (.not. g%grid_ok(p)) then   ! the target's sub-triangles within reach of the impactor
@@ -92,17 +89,17 @@ contains
         g%grid_ok(p) = .true.
       end if
       if (bi == bt) then   ! self-contact: not the surface around the node
-        call nearest_subtriangle(g%surf(bt), g%grid(p), x, xn, r, ok, itri, xq, bary, &
+        call nearest_subtriangle(g%surf(bt), g%grid(p), x, x(:, node), r, ok, itri, xq, bary, &
                                  dist, region, model%x0, model%x0(:, node), g%skip(bt))
       else
-        call nearest_subtriangle(g%surf(bt), g%grid(p), x, xn, r, ok, itri, xq, bary, &
+        call nearest_subtriangle(g%surf(bt), g%grid(p), x, x(:, node), r, ok, itri, xq, bary, &
                                  dist, region)
       end if
       if (.not. ok) return
       associate (t => g%surf(bt)%tri(:, itri))
         nt = cross(x(:, t(2)) - x(:, t(1)), x(:, t(3)) - x(:, t(1)))
       end associate
-      con%sd = sign(dist, dot_product(xn - xq, nt))
+      con%sd = sign(dist, dot_product(x(:, node) - xq, nt))
       ! beside an open surface's rim (the nearest point on an edge or a vertex, the node off
       ! to the side of the sub-triangle's plane, not above or behind it) there is nothing to
       ! press on: taken along the normal, a hoop passing a plate's edge was thrown back with
@@ -112,7 +109,7 @@ contains
       ! held on the rim too, along the rim's tilted normal, fought them (a blade dropped
       ! edge-first onto a plate, 60 degrees from it, made 1.1 times the energy in a step).
       if (region /= region_face) then
-        if (abs(dot_product(xn - xq, nt)) < 0.5_dp*dist*norm2(nt)) then
+        if (abs(dot_product(x(:, node) - xq, nt)) < 0.5_dp*dist*norm2(nt)) then
           ok = .false.
           return
         end if
@@ -159,8 +156,8 @@ contains
     real(dp), intent(in) :: x(:, :), q(:)
     type(constraint_t), intent(inout) :: con
     type(normal_cache_t), intent(inout), optional :: normals
-    real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3), gm, gt(3), ft, dxi(2)
-    integer :: j, i, nd, bi, bt, it
+    real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3), gm, gt(3), ft
+    integer :: j, i, nd, bi, bt
     bi = c%pair(1, con%pair); bt = c%pair(2, con%pair)
     con%off = 0; con%wg = 0
     if (bt <= 0) then
@@ -173,91 +170,52 @@ contains
       call friction_geometry()
       return
     end if
-    ! between faces the point moves (lever) until the faces' points are on one normal
-    call at_point()
-    do it = 1, merge(30, 0, c%faces)
-      call lever(dxi)
-      if (maxval(abs(dxi)) <= 1e-13_dp) exit
-      if (min(con%xi(1) + dxi(1), con%xi(2) + dxi(2), 1 - sum(con%xi + dxi)) < -0.5_dp) exit
-      con%xi = con%xi + dxi
-      call at_point()
-    end do
+    call tri10_shape(con%xi(1), con%xi(2), con%shp, dphi)
+    xe = x(:, model%conn(:, con%elem))   ! gathered once for the point and both tangents
+    xt = matmul(xe, con%shp)
+    if (c%nodal_normal) then
+      con%n = 0
+      associate (g => c%geo)
+        do j = 1, 10
+          nd = model%conn(j, con%elem)
+          own = normal_at(con%elem, j)
+          m = 0   ! the normals of the elements at node j, turned to this element's side
+          do i = g%node_start(nd), g%node_start(nd + 1) - 1
+            ne = normal_at(g%node_elem(i), g%node_loc(i))
+            m = m + sign(1._dp, dot_product(ne, own))*ne
+          end do
+          con%n = con%n + (con%shp(j)/norm2(m))*m
+        end do
+      end associate
+    else
+      con%n = unit_normal(xe, dphi)
+    end if
+    con%n = con%n/norm2(con%n)
+    gm = dot_product(x(:, con%node) - xt, con%n)
+    ! between mid-surfaces the target is one-sided (the thesis: its normal's side); between
+    ! faces a shell is two-sided and the node stays on the side it came from
+    if (con%side == 0) then
+      con%side = 1
+      if (c%faces) con%side = int(sign(1._dp, gm))
+    end if
+    con%n = con%side*con%n
+    if (c%faces) then
+      gt = 0
+      do j = 1, 10
+        nd = model%conn(j, con%elem)
+        gt = gt + con%shp(j)*q(dof(nd, 4):dof(nd, 6))
+      end do
+      ! the impactor's face towards the target (along -n), the target's towards the node
+      call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), -con%n, con%face(1), &
+                con%off, con%wg(1), c%rim(con%node))
+      call face(model%body(bt)%thickness, gt, con%n, con%face(2), ft, con%wg(2))
+      con%off = con%off + ft
+      con%wg(2) = -con%wg(2)
+    end if
     con%gap = con%side*gm - con%off
     call hold_force_point(con)
     call friction_geometry()
   contains
-    !> shape functions, normal, offsets and mid-surface gap gm at con%xi
-    subroutine at_point()
-      call tri10_shape(con%xi(1), con%xi(2), con%shp, dphi)
-      xe = x(:, model%conn(:, con%elem))   ! gathered once for the point and both tangents
-      xt = matmul(xe, con%shp)
-      if (c%nodal_normal) then
-        con%n = 0
-        associate (g => c%geo)
-          do j = 1, 10
-            nd = model%conn(j, con%elem)
-            own = normal_at(con%elem, j)
-            m = 0   ! the normals of the elements at node j, turned to this element's side
-            do i = g%node_start(nd), g%node_start(nd + 1) - 1
-              ne = normal_at(g%node_elem(i), g%node_loc(i))
-              m = m + sign(1._dp, dot_product(ne, own))*ne
-            end do
-            con%n = con%n + (con%shp(j)/norm2(m))*m
-          end do
-        end associate
-      else
-        con%n = unit_normal(xe, dphi)
-      end if
-      con%n = con%n/norm2(con%n)
-      gm = dot_product(x(:, con%node) - xt, con%n)
-      ! between mid-surfaces the target is one-sided (the thesis: its normal's side); between
-      ! faces a shell is two-sided and the node stays on the side it came from
-      if (con%side == 0) then
-        con%side = 1
-        if (c%faces) con%side = int(sign(1._dp, gm))
-      end if
-      con%n = con%side*con%n
-      if (c%faces) then
-        gt = 0
-        do j = 1, 10
-          nd = model%conn(j, con%elem)
-          gt = gt + con%shp(j)*q(dof(nd, 4):dof(nd, 6))
-        end do
-        ! the impactor's face towards the target (along -n), the target's towards the node
-        call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), -con%n, con%face(1), &
-                  con%off, con%wg(1), c%rim(con%node))
-        call face(model%body(bt)%thickness, gt, con%n, con%face(2), ft, con%wg(2))
-        con%off = con%off + ft
-        con%wg(2) = -con%wg(2)
-      end if
-    end subroutine at_point
-
-    !> The step of xi towards the point where T(xi) + s n = P (force_point's line: T the
-    !> target's face, P the node's, both along the offsets' derivatives wg), n held. There the
-    !> vector between them lies along n, so the gap is stationary in n's turn: the row needs
-    !> no derivative of the target's normal (at the node's own projection, a fibre tilted
-    !> from n puts P up to 3 (h/2) sin off that line in the fade band, and the target's turn
-    !> changed the gap at a lever the row did not hold: the row's error on the plate's points
-    !> was as large as the row itself (finite differences), and a blade (h 10 mm) landing at
-    !> 62 degrees on a free plate under the midpoint rule made 7.3% of E0, now none)
-    subroutine lever(dxi)
-      real(dp), intent(out) :: dxi(2)
-      real(dp) :: ye(3, 10), p(3), jm(3, 3), f(3), det
-      integer :: kk, nn
-      do kk = 1, 10
-        nn = model%conn(kk, con%elem)
-        ye(:, kk) = x(:, nn) - con%wg(2)*q(dof(nn, 4):dof(nn, 6))
-      end do
-      p = x(:, con%node) + con%wg(1)*q(dof(con%node, 4):dof(con%node, 6))
-      jm(:, 1:2) = matmul(ye, dphi); jm(:, 3) = con%n
-      f = p - matmul(ye, con%shp)
-      det = dot_product(jm(:, 1), cross(jm(:, 2), jm(:, 3)))
-      dxi = 0
-      if (.not. abs(det) > 0) return
-      dxi(1) = dot_product(f, cross(jm(:, 2), jm(:, 3)))/det
-      dxi(2) = dot_product(jm(:, 1), cross(f, jm(:, 3)))/det
-    end subroutine lever
-
     !> the unit normal of element e at its node k
     function normal_at(e, k) result(nk)
       integer, intent(in) :: e, k
@@ -321,8 +279,8 @@ contains
   !> thickness), and the offset has no jump anywhere. f depends on G through k alone, so w
   !> is its whole derivative (phi of |k|/|G| left G's stretch out of the row: a thick blade
   !> landing at 62 degrees on a rigid plane gained 2.5% of E0 through its contact, now
-  !> 1e-11; against a body, w's lever on the target's normal is taken out by the point
-  !> constraint_geometry chooses). (Until 2026-11-27 an edge was
+  !> 1e-11; thick shells against a body within this band still gain up to a few 10% of E0
+  !> on some scenes, docs/performance.md "Fifteenth session"). (Until 2026-11-27 an edge was
   !> chosen past 60 degrees, with offset 0 against the face's h/4 there: a blade landing at
   !> 60 degrees, its fibres shaking across that angle, had nodes found at the edge's gap and
   !> taken again at the face's, h/4 deep, and pushed out in one step: 16 times E0. A node
