@@ -255,8 +255,9 @@ contains
       if (r%restart /= '') then   ! (statics: t is the load factor, <= 1)
         call load_checkpoint(r%restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
                              'static'), deck%run%max_step_cuts, r%st, r%level, r%err, r%contact, &
-                             r%dt_try, cap)
+                             r%dt_try, cap, r%bal%pressure_path)
         if (failed(r, 'restart')) return
+        r%bal%q_path = r%st%q   ! (the pressures' work on open surfaces goes on from here)
         r%dt_cap = cap(1); r%cap_since = cap(2)
         r%restart_step = r%st%step
       end if
@@ -285,7 +286,8 @@ contains
     real(dp), parameter :: made_limit = 1e-2_dp
     !> guarded: the balance is exact step by step (not so for the work of moving obstacles,
     !> counted as their velocity times the step's impulse, nor for pressures on open
-    !> surfaces); energy_cut: this step was cut for its energy once already (a half step that
+    !> surfaces, summed along the straight segment between the states, not at the scheme's
+    !> force level); energy_cut: this step was cut for its energy once already (a half step that
     !> makes energy too is kept: a shorter one made more on a plane pushing a ring)
     logical :: guarded, energy_cut
     character(len=:), allocatable :: why
@@ -885,7 +887,8 @@ contains
     call r%ls%drop_factors()
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
     if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e, &
-                                                  r%dt_try, [r%dt_cap, r%cap_since])
+                                                  r%dt_try, [r%dt_cap, r%cap_since], &
+                                                  r%bal%pressure_path)
     call share_error(e)
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message

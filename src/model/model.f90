@@ -38,6 +38,9 @@ module casca_model
     logical, allocatable :: fixed(:)         !< (ndof) prescribed parameters
     real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
     real(dp), allocatable :: pressure(:)     !< (nelem) follower pressure on each element [Pa]
+    !> (nelem) the element's body's loaded elements make closed surfaces under one pressure:
+    !> its work is p (V - V0) there (casca_pressure_assembly), a sum along the path elsewhere
+    logical, allocatable :: pressure_closed(:)
     logical :: load_stiffness = .true.       !< the pressures' load stiffness in the tangent
     real(dp) :: length = 1                   !< size of the scene (bounding-box diagonal)
   end type model_t
@@ -155,8 +158,8 @@ contains
     end do
     allocate (model%fixed(model%ndof), model%fext(model%ndof))
     model%fixed = .false.; model%fext = 0
-    allocate (model%pressure(model%nelem))
-    model%pressure = 0
+    allocate (model%pressure(model%nelem), model%pressure_closed(model%nelem))
+    model%pressure = 0; model%pressure_closed = .false.
     model%length = norm2(maxval(model%x0, dim=2) - minval(model%x0, dim=2))
   end subroutine model_finalize
 

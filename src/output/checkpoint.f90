@@ -1,5 +1,6 @@
-!> Restart checkpoints of a run: the state, the step-cut level and the contact active set
-!> (each constraint's node, pair, point, side, faces, multiplier and acceleration correction),
+!> Restart checkpoints of a run: the state, the step-cut level, the contact active set
+!> (each constraint's node, pair, point, side, faces, multiplier and acceleration correction)
+!> and the pressures' work on open surfaces (a sum over the steps, casca_accounting),
 !> with a fingerprint of the model they belong to (mesh, materials, restraints) and a checksum
 !> of the state. A checkpoint is read back only when its fingerprint is this deck's, every
 !> field is in range and its contents match their checksum; a state
@@ -70,7 +71,7 @@ contains
 
   !> Write the checkpoint path (rank 0; the caller shares err): refused if the state or the
   !> multipliers are not finite.
-  subroutine save_checkpoint(path, model, st, level, contact, err, dt_next, cap)
+  subroutine save_checkpoint(path, model, st, level, contact, err, dt_next, cap, pressure_work)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
@@ -80,6 +81,7 @@ contains
     real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)
     !> and the energy's cap on it (huge: none) and when it was set or last doubled
     real(dp), intent(in), optional :: cap(2)
+    real(dp), intent(in), optional :: pressure_work   !< (balance_t%pressure_path)
     integer, allocatable :: ints(:)
     real(dp), allocatable :: reals(:)
     integer :: k, nact
@@ -117,14 +119,21 @@ contains
       ints = [level, 0]
       allocate (reals(0))
     end if
-    call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
-                          model_fingerprint(model), dt_next, state_checksum(st, ints, reals), cap)
+    if (present(pressure_work)) then   ! (checked with the rest)
+      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
+                            model_fingerprint(model), dt_next, &
+                            state_checksum(st, ints, [reals, pressure_work]), cap, pressure_work)
+    else
+      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
+                            model_fingerprint(model), dt_next, state_checksum(st, ints, reals), cap)
+    end if
   end subroutine save_checkpoint
 
   !> Read the checkpoint path into st, level and the contact active set, after checking that
   !> it belongs to this model and that every field is in range: 0 <= t <= t_max, step >= 0,
   !> 0 <= level <= max_level, each constraint an impactor node of one of the contact pairs.
-  subroutine load_checkpoint(path, model, t_max, max_level, st, level, err, contact, dt_next, cap)
+  subroutine load_checkpoint(path, model, t_max, max_level, st, level, err, contact, dt_next, cap, &
+                             pressure_work)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: t_max
@@ -135,6 +144,10 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp), intent(out), optional :: dt_next   !< 0: not in the checkpoint
     real(dp), intent(out), optional :: cap(2)    !< [huge, 0]: not in the checkpoint
+    !> the pressures' work on open surfaces so far (0: not in the checkpoint, which one
+    !> written before it was kept or of a scene without such pressures is)
+    real(dp), intent(out), optional :: pressure_work
+    real(dp), allocatable :: pw
     integer, allocatable :: ints(:), fp(:), cs(:)
     real(dp), allocatable :: cp(:)   ! (the energy's cap and when it was set)
     real(dp), allocatable :: reals(:)
@@ -143,8 +156,10 @@ contains
     logical :: with_fa
 
     level = 0
-    call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next, cs, cp)
+    call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next, cs, &
+                         cp, pw)
     if (allocated(err)) return
+    if (present(pressure_work)) pressure_work = 0
     bad = ''
     if (.not. allocated(fp)) then
       bad = 'it has no model fingerprint (written by an older casca)'
@@ -233,7 +248,7 @@ contains
     if (bad == '' .and. allocated(cs)) then   ! (last: the checks above name what is out of range)
       if (size(cs) /= 2) then
         bad = 'its checksum is not two numbers'
-      else if (any(cs /= state_checksum(st, ints, reals))) then
+      else if (any(cs /= checksum_read())) then
         bad = 'its contents do not match their checksum (the file was changed or damaged '// &
               'after casca wrote it)'
       end if
@@ -243,6 +258,13 @@ contains
     end if
     if (.not. allocated(cs) .and. is_root()) write (0, '(a)') 'warning: '//path// &
       ' has no checksum (written by an older casca): its contents cannot be checked'
+    if (allocated(pw)) then
+      if (.not. ieee_is_finite(pw)) then
+        call fatal_error(err, path//': not a checkpoint of this deck: its pressure work is not finite')
+        return
+      end if
+      if (present(pressure_work)) pressure_work = pw
+    end if
 
     if (.not. present(contact)) return
     contact%nact = nact   ! the active set
@@ -291,5 +313,15 @@ contains
       if (contact%act(k)%elem > 0 .or. contact%pair(2, contact%act(k)%pair) <= 0) &
         call constraint_geometry(contact, model, positions(model, st%q), st%q, contact%act(k))
     end do
+  contains
+    !> the checksum of what was read (the pressure work with the reals, as save_checkpoint)
+    function checksum_read() result(c)
+      integer :: c(2)
+      if (allocated(pw)) then
+        c = state_checksum(st, ints, [reals, pw])
+      else
+        c = state_checksum(st, ints, reals)
+      end if
+    end function checksum_read
   end subroutine load_checkpoint
 end module casca_checkpoint

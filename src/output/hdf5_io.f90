@@ -333,7 +333,7 @@ contains
   !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
   !> have any size, including 0.
   subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
-                              checksum, dt_cap)
+                              checksum, dt_cap, pressure_work)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
@@ -345,6 +345,7 @@ contains
     real(dp), intent(in), optional :: dt_next   !< the next step's length (error-controlled runs)
     integer, intent(in), optional :: checksum(:)
     real(dp), intent(in), optional :: dt_cap(:) !< the energy's cap on the steps and when set (idem)
+    real(dp), intent(in), optional :: pressure_work   !< the pressures' on open surfaces so far
 
     character(len=*), parameter :: who = 'write_checkpoint'
     integer(hid_t) :: fid
@@ -377,14 +378,16 @@ contains
       call put_int_1d(who, path, fid, 'checksum', checksum, err)
     if (present(dt_cap) .and. .not. allocated(err)) &
       call put_real_1d(who, path, fid, 'dt_cap', dt_cap, err)
+    if (present(pressure_work) .and. .not. allocated(err)) &
+      call put_real_scalar(who, path, fid, 'pressure_work', pressure_work, err)
     if (.not. allocated(err)) call save_image(who, path, fid, err)
     call h5fclose_f(fid, h)   ! (in memory: nothing to fail on)
   end subroutine write_checkpoint
 
   !> Read a checkpoint written by write_checkpoint (fingerprint, checksum: not allocated if it
-  !> has none; dt_next: 0 if it has none; dt_cap: not allocated if it has none).
+  !> has none; dt_next: 0 if it has none; dt_cap, pressure_work: not allocated if it has none).
   subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
-                             checksum, dt_cap)
+                             checksum, dt_cap, pressure_work)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
@@ -396,6 +399,7 @@ contains
     real(dp), intent(out), optional :: dt_next
     integer, allocatable, intent(out), optional :: checksum(:)
     real(dp), allocatable, intent(out), optional :: dt_cap(:)
+    real(dp), allocatable, intent(out), optional :: pressure_work
 
     character(len=*), parameter :: who = 'read_checkpoint'
     integer(hid_t) :: fid
@@ -432,6 +436,13 @@ contains
     if (present(dt_cap) .and. .not. allocated(err)) then
       call h5lexists_f(fid, 'dt_cap', has_dt, h)
       if (h == 0 .and. has_dt) call get_real_1d(who, path, fid, 'dt_cap', dt_cap, err)
+    end if
+    if (present(pressure_work) .and. .not. allocated(err)) then
+      call h5lexists_f(fid, 'pressure_work', has_dt, h)
+      if (h == 0 .and. has_dt) then
+        allocate (pressure_work)
+        call get_real_scalar(who, path, fid, 'pressure_work', pressure_work, err)
+      end if
     end if
     call h5fclose_f(fid, h)
     if (allocated(err)) return

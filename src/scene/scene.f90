@@ -175,7 +175,28 @@ contains
       model%body(k)%gravity = deck%run%gravity + deck%bodies(k)%gravity
     end do
     model%load_stiffness = deck%run%load_stiffness
+    call closed_pressures(model)
   end subroutine build_model
+
+  !> model%pressure_closed: per body, its loaded elements carry one pressure and every edge of
+  !> theirs is shared by exactly two of them, traversed both ways (no rim, branch or flip).
+  !> Only there is the follower pressure conservative whatever the restraints, with the
+  !> potential -p V: elsewhere the element volumes' rim terms depend on the origin.
+  subroutine closed_pressures(model)
+    type(model_t), intent(inout) :: model
+    type(edge_census_t) :: ec
+    integer, allocatable :: loaded(:)
+    integer :: k, e
+    do k = 1, model%nbody
+      associate (b => model%body(k))
+        loaded = pack([(e, e=b%elem_first, b%elem_last)], model%pressure(b%elem_first:b%elem_last) /= 0)
+        if (size(loaded) == 0) cycle
+        if (any(model%pressure(loaded) /= model%pressure(loaded(1)))) cycle
+        ec = edge_census(model%conn(:, loaded), model%nnode)
+        model%pressure_closed(loaded) = ec%open == 0 .and. ec%branch == 0 .and. ec%disagree == 0
+      end associate
+    end do
+  end subroutine closed_pressures
 
   !> Contact pairs (impactor, target) of the deck: those it lists (a body twice: self-contact),
   !> or every pair of bodies, the impactor chosen by impacts_first ('faces'); with passes = 2

@@ -11,7 +11,7 @@ module casca_pressure_assembly
   use casca_mpi, only: sum_all
   implicit none
   private
-  public :: add_pressure, pressure_work_local
+  public :: add_pressure, pressure_work_local, pressure_path_local
 
 contains
 
@@ -83,9 +83,10 @@ contains
     scale = max(scale, 0._dp)   ! (every parameter fixed: maxval of nothing)
   end subroutine add_pressure
 
-  !> This rank's share of the pressure's work at q from q0, factor sum p (V(q) - V(q0))
-  !> over elems (pressure_volume): the work exactly when the loaded surface is closed or its
-  !> boundary is held (docs/method.md); not summed over the ranks.
+  !> This rank's share of the pressures' work at q from q0 on the closed surfaces
+  !> (model%pressure_closed), factor sum p (V(q) - V(q0)) over elems (pressure_volume): exact
+  !> there, a function of the state; not summed over the ranks. The open surfaces' is
+  !> pressure_path_local's.
   real(dp) function pressure_work_local(model, elems, q, q0, factor) result(w)
     type(model_t), intent(in) :: model
     integer, intent(in) :: elems(:)
@@ -95,13 +96,37 @@ contains
     w = 0
     do i = 1, size(elems)
       e = elems(i)
-      if (model%pressure(e) == 0) cycle
+      if (model%pressure(e) == 0 .or. .not. model%pressure_closed(e)) cycle
       call element_positions(model, q, e, y)
       call element_positions(model, q0, e, y0)
       w = w + model%pressure(e)*(pressure_volume(model%rule, y) - pressure_volume(model%rule, y0))
     end do
     w = factor*w
   end function pressure_work_local
+
+  !> This rank's share of the pressures' work at load factor 1 on the open surfaces (those
+  !> not model%pressure_closed) along the straight path from qa to qb, by Simpson's rule:
+  !> f_p is quadratic in the positions, so the rule is exact on the segment. On an open
+  !> surface the follower pressure has no potential (p (V - V0) there depends on the
+  !> origin), so its work is this sum over the steps; not summed over the ranks.
+  real(dp) function pressure_path_local(model, elems, qa, qb) result(w)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: elems(:)
+    real(dp), intent(in) :: qa(:), qb(:)
+    real(dp) :: ya(3, 10), yb(3, 10), fa(3, 10), fm(3, 10), fb(3, 10), k(3, 10, 3, 10)
+    integer :: i, e
+    w = 0
+    do i = 1, size(elems)
+      e = elems(i)
+      if (model%pressure(e) == 0 .or. model%pressure_closed(e)) cycle
+      call element_positions(model, qa, e, ya)
+      call element_positions(model, qb, e, yb)
+      call pressure_force(model%rule, model%pressure(e), ya, .false., fa, k)
+      call pressure_force(model%rule, model%pressure(e), (ya + yb)/2, .false., fm, k)
+      call pressure_force(model%rule, model%pressure(e), yb, .false., fb, k)
+      w = w + sum((yb - ya)*(fa + 4*fm + fb))/6
+    end do
+  end function pressure_path_local
 
   !> the positions Y of element e's 10 nodes from a full-length vector
   pure subroutine element_positions(model, q, e, y)
