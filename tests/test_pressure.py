@@ -55,6 +55,13 @@ RESTRAINTS = [((0, 1, PHI), "x"), ((0, -1, -PHI), "x"), ((PHI, 0, 1), "y"),
               ((-PHI, 0, -1), "y"), ((1, PHI, 0), "z"), ((-1, -PHI, 0), "z")]
 
 
+
+def two_ranks(casca, ck, work, name, deck, out):
+    """the deck (in work) run again on 2 ranks into out: its history, None when it failed"""
+    p = run([casca, "run", os.path.join(work, deck), "--out", os.path.join(work, out), "-q"], np_ranks=2)
+    ck.record("%s on 2 ranks: runs to the end (exit 0)" % name, p.returncode == 0, p.stderr[-300:])
+    return history(os.path.join(work, out)) if p.returncode == 0 else None
+
 def sphere_deck(run_keys, pressure, restrained=True, output=""):
     lines = ["&run\n  %s\n/" % run_keys,
              "&output\n  vtu = .false., plots = .false.\n  track = 1.0, 0.0, 0.0,  0.0, 0.0, 1.0\n%s/"
@@ -129,12 +136,8 @@ def large_pressure(casca, ck, work):
           1.5 * sum(h["newton"]), sum(hk["newton"]))
     ck.le("large p: the same answer without the load stiffness (rel)",
           abs(radii(hk)[0][-1] - radii(h)[0][-1]) / (radii(h)[0][-1] - R), 1e-6)
-    deck = os.path.join(work, "large.nml")
-    out2 = os.path.join(work, "large_np2")
-    p2 = run([casca, "run", deck, "--out", out2, "-q"], np_ranks=2)
-    ck.record("large p on 2 ranks: runs to the end (exit 0)", p2.returncode == 0, p2.stderr[-300:])
-    if p2.returncode == 0:
-        h2 = history(out2)
+    h2 = two_ranks(casca, ck, work, "large p", "large.nml", "large_np2")
+    if h2 is not None:
         ck.le("large p on 2 ranks: tracked radius as on 1 rank (rel)",
               abs(radii(h2)[0][-1] - radii(h)[0][-1]) / (radii(h)[0][-1] - R), 1e-9)
         ck.record("large p on 2 ranks: the same Newton iterations per load step",
@@ -225,11 +228,8 @@ def open_surface(casca, ck, work):
     ck.le("strip dynamics: the moved strip's work = the other's (of the largest)",
           np.max(np.abs(a["work"] - b["work"])) / np.max(np.abs(a["work"])), 1e-6)
     deck = os.path.join(work, "strip_dynamic_moved.nml")
-    out2 = os.path.join(work, "strip_dynamic_np2")
-    p2 = run([casca, "run", deck, "--out", out2, "-q"], np_ranks=2)
-    ck.record("strip dynamics on 2 ranks: runs to the end (exit 0)", p2.returncode == 0, p2.stderr[-300:])
-    if p2.returncode == 0:
-        h2 = history(out2)
+    h2 = two_ranks(casca, ck, work, "strip dynamics", "strip_dynamic_moved.nml", "strip_dynamic_np2")
+    if h2 is not None:
         ck.le("strip dynamics on 2 ranks: the work as on 1 rank (of the largest)",
               np.max(np.abs(h2["work"] - b["work"])) / np.max(np.abs(b["work"])), 1e-9)
     half, _ = run_scene(casca, ck, work, "strip_half",
