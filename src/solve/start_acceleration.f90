@@ -27,7 +27,7 @@ contains
     real(dp), intent(inout) :: qdd(:)
     type(error_t), allocatable, intent(out) :: err
     type(mass_solver_t), intent(inout), optional, target :: ms
-    type(mass_solver_t), target :: own
+    type(mass_solver_t), allocatable, target :: own   ! (allocatable: large, kept off the stack)
     type(mass_solver_t), pointer :: m
     real(dp), allocatable :: r(:), a(:)
     real(dp) :: energy, scale
@@ -39,11 +39,12 @@ contains
     if (present(ms)) then
       m => ms
     else
+      allocate (own)
       call mass_setup(model, own, err)
       m => own
     end if
     if (.not. allocated(err)) call m%solve(-r, a, err)
-    if (.not. present(ms)) call own%finish()
+    if (allocated(own)) call own%finish()
     if (allocated(err)) return
     do b = 1, model%nbody
       if (.not. which(b)) cycle
