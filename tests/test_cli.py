@@ -195,6 +195,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
                                               "  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n"
                                               "  thickness = 0.025\n", 1),
      ["&body", "thickness is given twice (lines 12 and 13)", "keep one", ":13:"]),
+    ("an empty value", lambda s: s.replace("young = 210e9, poisson", "young = 210e9,, poisson", 1),
+     ["&body", "young has an empty value", ":12:"]),
     ("a vector short of a number", lambda s: s.replace("velocity = 10.0, 0.0, 0.0", "velocity = 10.0, 0.0", 1),
      ["&body", "velocity takes 3 numbers (x, y, z), 2 given", ":11:"]),
     ("E not positive", lambda s: s.replace("young = 210e9", "young = -1.0", 1), ["young", "> 0"]),

@@ -90,7 +90,7 @@ contains
     character(len=20), allocatable :: seen(:)   !< the keys given so far, and their lines
     integer, allocatable :: seen_line(:)
     integer :: nval, key_line
-    logical :: indexed
+    logical :: indexed, comma   !< comma: the last item was a comma
 
     ! the group as one string (comments cut), with the line of each character
     allocate (lines(0), msgs(0))
@@ -119,22 +119,34 @@ contains
     p = index(s, '&') + 1 + len_trim(group)
     key = ''; t = ' '
     allocate (seen(0), seen_line(0))
-    nval = 0; key_line = 0; indexed = .false.
+    nval = 0; key_line = 0; indexed = .false.; comma = .false.
     done = .false.
     do while (p <= n .and. .not. done)
       select case (s(p:p))
-      case (' ', ',', achar(9))
+      case (' ', achar(9))
+        p = p + 1
+      case (',')
+        ! (a null value: Fortran's read says only "Cannot match namelist object name")
+        if (comma .and. key /= '' .and. t /= ' ') then
+          call report(lineof(p), '&'//group//': '//key//' has an empty value (two commas with '// &
+                      'nothing between)')
+          comma = .false.   ! (once for a run of commas)
+        else
+          comma = .true.
+        end if
         p = p + 1
       case ('/')
         call key_done()
         done = .true.
       case ("'", '"')
+        comma = .false.
         q = s(p:p)
         j = index(s(p + 1:), q)
         if (j == 0) j = n - p
         call value(s(p:p + j), lineof(p))
         p = p + j + 1
       case default
+        comma = .false.
         j = p
         do while (j <= n)
           if (index(' ,/=', s(j:j)) > 0 .or. s(j:j) == achar(9)) exit
