@@ -727,8 +727,8 @@ contains
   !> change).
   subroutine start_acceleration(r)
     type(run_t), intent(inout) :: r
-    logical :: falls(r%model%nbody), held(r%model%nbody), ground(r%model%nbody), loaded(r%model%nbody)
-    logical, allocatable :: near(:), moves(:)
+    logical, dimension(r%model%nbody) :: falls, held, ground, loaded, moves
+    logical, allocatable :: near(:)
     integer :: b, n
     associate (model => r%model, st => r%st)
       do b = 1, model%nbody
@@ -736,7 +736,7 @@ contains
           ground(b) = any(model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7)))
           falls(b) = any(bd%gravity /= 0) .and. .not. ground(b)
           loaded(b) = any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0) .or. &
-                      any(model%pressure /= 0 .and. model%elem_body == b)
+                      any(model%pressure(bd%elem_first:bd%elem_last) /= 0)
         end associate
       end do
       if (allocated(r%contact)) then
@@ -886,9 +886,9 @@ contains
     ! on every rank: a restart from here starts with new factors
     call r%ls%drop_factors()
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
-    if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, r%contact, e, &
-                                                  r%dt_try, [r%dt_cap, r%cap_since], &
-                                                  r%bal%pressure_path)
+    if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, &
+                                                  r%bal%pressure_path, r%contact, e, r%dt_try, &
+                                                  [r%dt_cap, r%cap_since])
     call share_error(e)
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message

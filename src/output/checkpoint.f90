@@ -71,17 +71,17 @@ contains
 
   !> Write the checkpoint path (rank 0; the caller shares err): refused if the state or the
   !> multipliers are not finite.
-  subroutine save_checkpoint(path, model, st, level, contact, err, dt_next, cap, pressure_work)
+  subroutine save_checkpoint(path, model, st, level, pressure_work, contact, err, dt_next, cap)
     character(len=*), intent(in) :: path
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
     integer, intent(in) :: level
+    real(dp), intent(in) :: pressure_work   !< on open surfaces so far (balance_t%pressure_path)
     type(contact_t), intent(in), optional :: contact
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)
     !> and the energy's cap on it (huge: none) and when it was set or last doubled
     real(dp), intent(in), optional :: cap(2)
-    real(dp), intent(in), optional :: pressure_work   !< (balance_t%pressure_path)
     integer, allocatable :: ints(:)
     real(dp), allocatable :: reals(:)
     integer :: k, nact
@@ -119,14 +119,9 @@ contains
       ints = [level, 0]
       allocate (reals(0))
     end if
-    if (present(pressure_work)) then   ! (checked with the rest)
-      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
-                            model_fingerprint(model), dt_next, &
-                            state_checksum(st, ints, [reals, pressure_work]), cap, pressure_work)
-    else
-      call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
-                            model_fingerprint(model), dt_next, state_checksum(st, ints, reals), cap)
-    end if
+    call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
+                          model_fingerprint(model), dt_next, &
+                          state_checksum(st, ints, [reals, pressure_work]), cap, pressure_work)
   end subroutine save_checkpoint
 
   !> Read the checkpoint path into st, level and the contact active set, after checking that

@@ -116,8 +116,8 @@ contains
       real(dp) :: cm
       allocate (qs(size(st%q)))
       call nm%inertia(st%q, st%qd, a0, cm, qs)
-      ! (the first step's start acceleration is M^-1 F of the loads, spiky under a point
-      ! load: predicted from, it failed Newton's first step on a thin strip)
+      ! (the first step's start acceleration is the loads' M^-1 F, not a step's: spiky under
+      ! a point load, and predicted from it Newton failed a thin strip's first step)
       if (.not. warm) call nm%predictor(st%q, st%qd, merge(a0, 0*a0, st%step > 0), q)
       where (model%fixed) q = st%q
       call newton_solve(model, asm, ls, q, fext, opts, rep, err, cm, qs, contact, st%q, nm%alpha_f)
