@@ -160,7 +160,7 @@ contains
       call take_increment()
       if (allocated(err)) exit
       if (refresh_next) cycle   ! (the increment was undone)
-      if (.not. small_enough(rep, step_tol())) then
+      if (.not. small_enough(rep, step_tol(opts%tol, q, model%length, qn))) then
         if (near_enough(rep, set_start, contact)) then
           if (set_changed(stick=.false.)) call new_set()
           if (allocated(err)) exit
@@ -222,19 +222,6 @@ contains
       fref = max(maxval(abs(fext)), fpress, maxval(abs(r + fext), mask=.not. model%fixed), &
                  maxval(abs(res - r), mask=.not. model%fixed))
     end subroutine full_residual
-
-    !> The iterate's error allowed: tol of the scene size, and in dynamics step_share of the
-    !> step's motion so far. Each step's error is left in the next step's start, and with
-    !> kept factors (contracting, not quadratic) it is about tol every step, of one sign
-    !> while the motion is smooth: summed over the steps it grows as 1/dt (a soft cantilever
-    !> under a tip load at 3,200 steps of 156 us ended 2.4% of its deflection low, at 4 times
-    !> the step 0.05%; and tolerance = 1e-8 gave a larger error than 1e-4). Held to a share of
-    !> the motion the error over a run stays that share of the path travelled.
-    real(dp) function step_tol()
-      step_tol = opts%tol
-      if (present(qn)) step_tol = max(min(opts%tol, step_share*maxval(abs(q - qn))/model%length), &
-                                      floor_share*opts%tol)
-    end function step_tol
 
     !> the residual at the new iterate: the last one, shrunk as the increments contract
     real(dp) function residual_estimate()
@@ -387,6 +374,21 @@ contains
     type(newton_report_t), intent(in) :: rep
     contraction = rep%incr(rep%nincr)/max(rep%incr(rep%nincr - 1), tiny(1._dp))
   end function contraction
+
+  !> The iterate's error allowed: tol of the scene size, and in dynamics (qn, the step's
+  !> start) step_share of the step's motion so far. Each step's error is left in the next
+  !> step's start, and with kept factors (contracting, not quadratic) it is about tol every
+  !> step, of one sign while the motion is smooth: summed over the steps it grows as 1/dt (a
+  !> soft cantilever under a tip load at 3,200 steps of 156 us ended 2.4% of its deflection
+  !> low, at 4 times the step 0.05%; and tolerance = 1e-8 gave a larger error than 1e-4).
+  !> Held to a share of the motion the error over a run stays that share of the path
+  !> travelled.
+  pure real(dp) function step_tol(tol, q, length, qn)
+    real(dp), intent(in) :: tol, q(:), length
+    real(dp), intent(in), optional :: qn(:)
+    step_tol = tol
+    if (present(qn)) step_tol = max(min(tol, step_share*maxval(abs(q - qn))/length), floor_share*tol)
+  end function step_tol
 
   !> The iterate's error, not the last increment, within tol: with contraction rho < 1/2
   !> what is left after this increment is at most about incr rho / (1 - rho) (a geometric
