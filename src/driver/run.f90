@@ -7,7 +7,7 @@ module casca_run
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
   use casca_starter, only: put_warnings, contact_time, static_warnings
-  use casca_model, only: model_t, reference_state, dof
+  use casca_model, only: model_t, reference_state, dof, thinnest
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
   use casca_mass_solver, only: mass_setup
@@ -80,6 +80,9 @@ module casca_run
     !> a body under gravity starts held by its contact (a = 0): its first step makes energy
     !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact: not watched
     logical :: held_at_start = .false.
+    !> the least thickness stretch the run's states reached, where and when (watch_thickness)
+    real(dp) :: squeeze = huge(1._dp), t_squeeze = 0
+    integer :: squeeze_node = 0
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
     type(error_t), allocatable :: err
@@ -357,6 +360,7 @@ contains
         nact0 = 0
         if (allocated(contact_before)) nact0 = contact_before%nact
         call watch_energy(r, rest, nact0)
+        call watch_thickness(r)
         if (.not. step_written(r, interval, next_frame, next_ckpt)) return
       end do
     end associate
@@ -509,6 +513,7 @@ contains
         end if
         st%t = real(i, dp)/deck%run%load_steps; st%step = i
         call account_state(r, factor=st%t)   ! (issue 17)
+        call watch_thickness(r)
         call history_row(r, r%rep%iters)
         if (failed(r, 'history')) return
         call frame(r)
@@ -914,10 +919,13 @@ contains
       '/checkpoint.h5 (restart with --restart) and in the last frame of '//r%dir//'/run.pvd'
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
-    if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') write (0, '(a)') &
-      'hint: '//r%nm%describe()//' keeps the shells'' fastest vibrations undamped, which can '// &
-      'stall Newton; rho_inf = 0.8 (generalized-alpha) damps them, second order '// &
-      '(or beta = 0.3025, gamma = 0.6; or the thesis'' beta = 1, gamma = 1.5)'
+    if (is_root() .and. squeezed(r)) then
+      write (0, '(a)') 'hint: '//squeeze_note(r)
+    else if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') then
+      write (0, '(a)') 'hint: '//r%nm%describe()//' keeps the shells'' fastest vibrations '// &
+        'undamped, which can stall Newton; rho_inf = 0.8 (generalized-alpha) damps them, '// &
+        'second order (or beta = 0.3025, gamma = 0.6; or the thesis'' beta = 1, gamma = 1.5)'
+    end if
     r%code = exit_solver
   end subroutine give_up
 
@@ -944,6 +952,7 @@ contains
         '/plots.gp was written but not run'
     end if
     if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
+    if (is_root() .and. squeezed(r)) write (0, '(a)') 'warning: '//squeeze_note(r)
     if (.not. is_root() .or. r%quiet) return
     associate (deck => r%deck, model => r%model)
       ! (the steps of this run: a restart's go on from the checkpoint's)
@@ -979,6 +988,42 @@ contains
     r%rest_last = rest
     r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
   end subroutine watch_energy
+
+  !> Keep the least thickness stretch of the run's states (thinnest)
+  subroutine watch_thickness(r)
+    type(run_t), intent(inout) :: r
+    real(dp) :: stretch
+    integer :: node
+    call thinnest(r%model, r%st%q, node, stretch)
+    if (stretch < r%squeeze) then
+      r%squeeze = stretch; r%squeeze_node = node; r%t_squeeze = r%st%t
+    end if
+  end subroutine watch_thickness
+
+  !> A shell squeezed through its thickness past Saint-Venant-Kirchhoff's limit: in uniaxial
+  !> compression its stress, E lambda (lambda^2 - 1)/2, is largest at lambda = 1/sqrt(3) and
+  !> falls as it is squeezed further, so the equations lose their solution there (a rubber
+  !> ring thrown at a floor at 15 m/s reached 0.2 and Newton stalled)
+  logical function squeezed(r)
+    type(run_t), intent(in) :: r
+    squeezed = r%squeeze < 1/sqrt(3._dp)
+  end function squeezed
+
+  function squeeze_note(r) result(msg)
+    type(run_t), intent(in) :: r
+    character(len=:), allocatable :: msg
+    character(len=:), allocatable :: how
+    integer :: n, b
+    n = r%squeeze_node; b = r%model%node_body(n)
+    how = 'squeezed through its thickness to '//itoa(nint(100*r%squeeze))//'%'
+    if (r%squeeze <= 0) how = 'turned inside out through its thickness'
+    msg = 'body '''//r%model%body(b)%name//''' was '//how//' at its node '//itoa(n - r%model%body(b)%node_first + 1)// &
+          ' (at '//trim(rtoa(r%model%x0(1, n)))//', '//trim(rtoa(r%model%x0(2, n)))//', '// &
+          trim(rtoa(r%model%x0(3, n)))//' at the start) at t = '//trim(rtoa(r%t_squeeze))// &
+          ' s; the Saint-Venant-Kirchhoff material holds to 58% only (squeezed further, its '// &
+          'stress falls): the results there are beyond the material law (a slower impact, or a '// &
+          'thicker or stiffer shell, stays within it)'
+  end function squeeze_note
 
   !> The run's energies and momenta now (accounting.f90); the total holds a compliant contact's
   !> energy too, as a spring's (the balance's remainder counts it as a term of its own)

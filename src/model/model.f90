@@ -12,7 +12,7 @@ module casca_model
   implicit none
   private
   public :: body_t, model_t, model_add_body, model_finalize, dof, element_dofs, reference_state
-  public :: area_points, thick_points, element_area
+  public :: area_points, thick_points, element_area, thinnest
 
   integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
   integer, parameter :: thick_points = 3
@@ -51,6 +51,24 @@ contains
     integer, intent(in) :: node, comp
     dof = ndof_node*(node - 1) + comp
   end function dof
+
+  !> The node squeezed most through its thickness and its stretch there, |G| (1 - 2|A|) at
+  !> its nearer face (G starts as a unit vector; A tilts the stretch through the thickness)
+  pure subroutine thinnest(model, q, node, stretch)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    integer, intent(out) :: node
+    real(dp), intent(out) :: stretch
+    real(dp) :: s
+    integer :: n
+    node = 0; stretch = huge(1._dp)
+    do n = 1, model%nnode
+      s = norm2(q(dof(n, 4):dof(n, 6)))*(1 - 2*abs(q(dof(n, 7))))
+      if (s < stretch) then
+        stretch = s; node = n
+      end if
+    end do
+  end subroutine thinnest
 
   !> The 70 dofs of element e in the element order 7(l-1)+c.
   pure function element_dofs(model, e) result(d)
