@@ -4,7 +4,7 @@ module casca_contact_active_set
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
-  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds
+  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds, new_constraint
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry, normal_cache_t, &
                                       normal_cache
   use casca_contact_friction, only: friction_on, friction_update
@@ -43,7 +43,7 @@ contains
       if (c%act(k)%grip == 0 .and. friction_on(c, c%act(k)%pair)) c%act(k)%grip = stick   ! (restart)
       if (present(reproject) .and. (c%pair(2, c%act(k)%pair) <= 0 .or. c%act(k)%elem > 0)) then
         if (.not. reproject) then
-          call constraint_geometry(c, model, x, q, c%act(k), normals); cycle
+          call constraint_geometry(c, model, x, q, c%act(k), normals, lever=.true.); cycle
         end if
       end if
       if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
@@ -60,7 +60,7 @@ contains
           c%act(k)%elem = 0; cycle
         end if
       end if
-      call constraint_geometry(c, model, x, q, c%act(k), normals)
+      call constraint_geometry(c, model, x, q, c%act(k), normals, lever=.true.)
     end do
     if (.not. detect) return
     do ip = 1, c%npairs
@@ -72,7 +72,7 @@ contains
           call obstacle_point(c%obstacle(-bt), c%time, x(:, n), nrm, d)
           if (d > reach) cycle
           if (holds(c, n, ip) .or. all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
-          cn = constraint_t(node=n, pair=ip)
+          cn = new_constraint(n, ip)
           call take(cn)
         end do
         cycle
@@ -109,6 +109,7 @@ contains
       end if
       if (cn%gap < -c%tol) then
         if (edge_on(cn)) return
+        call constraint_geometry(c, model, x, q, cn, normals, lever=.true.)   ! (its rows' too)
         call push(cn)
         added = added + 1
       end if

@@ -2,7 +2,9 @@
 !> A pair is (impactor body, target): a body (itself for self-contact) or a rigid obstacle.
 !> Every impactor node that penetrates its target gets one multiplier lambda and the condition
 !>     g = (x_imp - x_target(xi)) . n(xi) - offset = 0,   x_target = N_j(xi) Y^j,
-!> linearised with xi, n and the offset held (eq. 5.6). lambda < 0 is compression (the force
+!> linearised with xi, n and the offset held (eq. 5.6); between faces the row also holds the
+!> gap's derivative through n's turn (projection.f90, normal_lever), since the faces' points
+!> are off the normal through the target point. lambda < 0 is compression (the force
 !> on the impactor is -lambda n); a multiplier that turns tensile at convergence is released.
 !> The jobs live in their own files: projection.f90 (the point, normal and gap of one
 !> constraint), active_set.f90 (detection and release), rows.f90 (C, forces), correction.f90
@@ -17,6 +19,11 @@ module casca_contact
   private
   public :: contact_t, constraint_t, target_geometry_t, contact_init, face_reach, search_radius
   public :: contact_set_stiffness, normal_compliance, normal_residual, holds, tested_both_ways
+  public :: new_constraint
+
+  !> Most nodes a target normal depends on (the elements around its element's 10 nodes:
+  !> about 70 on a mesh of valence 6); a constraint with more leaves its lever out
+  integer, parameter, public :: max_lever = 100
 
   type :: constraint_t
     integer :: node = 0, pair = 0
@@ -36,6 +43,14 @@ module casca_contact
     real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)
     !> the gap's derivative on the fibres: wg(1) n.dG at the node, wg(2) sum_j N_j n.dG_j
     real(dp) :: wg(2) = 0
+    !> between faces, the gap's derivative through the target normal's turn, D . dn/dx_a
+    !> (projection.f90, normal_lever) on the positions of the nodes lnode(1:nl) that n
+    !> depends on: lgrad for the gap's row, lgradf (with wgf, the fibres' weights) for the
+    !> force's, taken where the scheme takes the internal force
+    integer :: nl = 0
+    integer :: lnode(max_lever)   ! (1:nl set; not initialised: a new constraint is cheap)
+    real(dp) :: lgrad(3, max_lever), lgradf(3, max_lever)
+    real(dp) :: wgf(2) = 0
     !> which face (+-1 on the fibre) of the impactor node and of the target is in
     !> contact, chosen when the constraint is made (0: not yet)
     integer :: face(2) = 0
@@ -110,6 +125,13 @@ module casca_contact
   end type contact_t
 
 contains
+
+  !> A constraint of node on pair p, not yet projected (its lever's arrays are not set)
+  pure function new_constraint(node, p) result(con)
+    integer, intent(in) :: node, p
+    type(constraint_t) :: con
+    con%node = node; con%pair = p
+  end function new_constraint
 
   !> pairs(2, npairs): impactor and target of each pair (-k: obstacle k of obstacles).
   !> tol: accepted penetration [m]; faces: contact at the shell faces.

@@ -223,7 +223,7 @@ contains
     do r = 1, size(rk)
       rows%ptr(r) = k + 1
       call row_factors(cons(rk(r)), model, rkind(r), .true., rows%node(k + 1:k + 22), &
-                       rows%par(k + 1:k + 22), rows%w(k + 1:k + 22), nw, rows%dir(:, r))
+                       rows%par(k + 1:k + 22), rows%w(k + 1:k + 22), nw, rows%dir(:, r), point=.true.)
       k = k + nw
     end do
     rows%ptr(size(rk) + 1) = k + 1

@@ -22,7 +22,7 @@ module casca_contact_projection
   use casca_obstacle, only: obstacle_point
   use casca_closest_point, only: region_face, region_edge_ab, region_edge_bc, region_edge_ca, &
                                  region_vertex_a, region_vertex_b, region_vertex_c
-  use casca_contact, only: contact_t, constraint_t, search_radius, tested_both_ways
+  use casca_contact, only: contact_t, constraint_t, search_radius, tested_both_ways, max_lever
   implicit none
   private
   public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face, &
@@ -37,7 +37,7 @@ module casca_contact_projection
     logical, allocatable :: made(:, :)    !< (10, nelem)
   end type normal_cache_t
 
-  integer, parameter, public :: max_row = 66   !< 11 nodes x (Y, G)
+  integer, parameter, public :: max_row = 66 + 3*max_lever   !< 11 nodes x (Y, G), the lever's nodes
 
 contains
 
@@ -149,17 +149,20 @@ contains
 
   !> Shape functions, normal (towards the node's side), faces' offset and gap of con at its
   !> point; for an obstacle (con%elem = 0 on an obstacle pair) the point is found here.
-  !> normals: the element normals made so far at these positions x.
-  subroutine constraint_geometry(c, model, x, q, con, normals)
+  !> normals: the element normals made so far at these positions x. lever: between faces,
+  !> the gap's derivative through the target normal's turn as well (normal_lever: for the
+  !> rows of an active constraint; else con%nl = 0).
+  subroutine constraint_geometry(c, model, x, q, con, normals, lever)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: x(:, :), q(:)
     type(constraint_t), intent(inout) :: con
     type(normal_cache_t), intent(inout), optional :: normals
+    logical, intent(in), optional :: lever
     real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3), gm, gt(3), ft
     integer :: j, i, nd, bi, bt
     bi = c%pair(1, con%pair); bt = c%pair(2, con%pair)
-    con%off = 0; con%wg = 0
+    con%off = 0; con%wg = 0; con%nl = 0
     if (bt <= 0) then
       con%elem = 0; con%side = 1; con%shp = 0
       call obstacle_point(c%obstacle(-bt), c%time, x(:, con%node), con%n, gm)
@@ -211,6 +214,14 @@ contains
       call face(model%body(bt)%thickness, gt, con%n, con%face(2), ft, con%wg(2))
       con%off = con%off + ft
       con%wg(2) = -con%wg(2)
+      ! the gap's derivative through n: D . dn, D = Y - T + wg1 G + wg2 G_t, whose part across
+      ! n (the face point P off the node's projection by up to 3 (h/2) sin in the rim's fade
+      ! band) turns the gap with the target's normal
+      if (present(lever)) then
+        if (lever) call normal_lever(c, model, x, con, x(:, con%node) - xt + &
+                                     con%wg(1)*q(dof(con%node, 4):dof(con%node, 6)) + con%wg(2)*gt, &
+                                     con%nl, con%lnode, con%lgrad, normals)
+      end if
     end if
     con%gap = con%side*gm - con%off
     call hold_force_point(con)
@@ -279,8 +290,8 @@ contains
   !> thickness), and the offset has no jump anywhere. f depends on G through k alone, so w
   !> is its whole derivative (phi of |k|/|G| left G's stretch out of the row: a thick blade
   !> landing at 62 degrees on a rigid plane gained 2.5% of E0 through its contact, now
-  !> 1e-11; thick shells against a body within this band still gain up to a few 10% of E0
-  !> on some scenes, docs/performance.md "Fifteenth session"). (Until 2026-11-27 an edge was
+  !> 1e-11; against a body the row needs n's turn as well, normal_lever: a blade 8 x 8 landing
+  !> at 60 degrees on a plate gained 9.8% of E0 without it, none with it). (Until 2026-11-27 an edge was
   !> chosen past 60 degrees, with offset 0 against the face's h/4 there: a blade landing at
   !> 60 degrees, its fibres shaking across that angle, had nodes found at the edge's gap and
   !> taken again at the face's, h/4 deep, and pushed out in one step: 16 times E0. A node
@@ -341,27 +352,46 @@ contains
   !> the friction pair had a moment: a spinning ball rattling in a shell lost 2.9e-4 of L
   !> in one impact, 3.5e-6 at shpf, test_friction 'rattle'). (The correction's mass solves
   !> need the scalar row only: one column per row, not one per component.)
-  pure subroutine row_factors(a, model, kind, force, node, par, w, nw, dir)
+  pure subroutine row_factors(a, model, kind, force, node, par, w, nw, dir, point)
     type(constraint_t), intent(in) :: a
     type(model_t), intent(in) :: model
     integer, intent(in) :: kind
     logical, intent(in) :: force
+    !> .true.: the force's row at its force point without the lever (the velocity
+    !> correction's: its rows are scalar rows times one direction, and the pair on one line
+    !> keeps the angular momentum)
+    logical, intent(in), optional :: point
     integer, intent(out) :: node(2*11), par(2*11), nw
     real(dp), intent(out) :: w(2*11), dir(3)
     integer :: j, nn
+    real(dp) :: wg(2)
+    logical :: lever
     select case (kind)
     case (0); dir = merge(a%nf, a%n, force)
     case (1, 2); dir = a%t(:, kind)
     case default; dir = a%s
     end select
-    call constraint_entries(a, model, node(1:11), w(1:11), nn, force)
+    ! a normal row with its lever is the gap's gradient itself, where the force is taken too
+    ! (at the gap's point: moment-free there as the gradient of a gap that turns with the
+    ! bodies, so the force point is not wanted)
+    lever = kind == 0 .and. a%nl > 0
+    if (present(point)) then
+      if (point .and. lever .and. force) then
+        lever = .false.; dir = a%n   ! (nf: the lever's normal, where the force is taken)
+      end if
+    end if
+    call constraint_entries(a, model, node(1:11), w(1:11), nn, force .and. .not. lever)
     par(1:nn) = 0
     nw = nn
-    if (all(a%wg == 0)) return   ! (every kind: the stick and slip rows are the faces' too)
+    wg = a%wg
+    if (force .and. lever) wg = a%wgf
+    ! (every kind: the stick and slip rows are the faces' too; the pattern follows wg and wgf
+    ! only, so that the gap's and the force's rows and every kind list the same parameters)
+    if (all(a%wg == 0) .and. all(a%wgf == 0)) return
     do j = 1, nn
-      if (merge(a%wg(1), a%wg(2), j == 1) == 0) cycle   ! (so the pattern follows wg only)
+      if (merge(a%wg(1), a%wg(2), j == 1) == 0 .and. merge(a%wgf(1), a%wgf(2), j == 1) == 0) cycle
       nw = nw + 1; node(nw) = node(j); par(nw) = 1
-      w(nw) = merge(a%wg(1), -w(j)*a%wg(2), j == 1)   ! (-w(j) = N_j on the target)
+      w(nw) = merge(wg(1), -w(j)*wg(2), j == 1)   ! (-w(j) = N_j on the target)
     end do
   end subroutine row_factors
 
@@ -375,8 +405,8 @@ contains
     real(dp), intent(out) :: v(max_row)
     integer, intent(in), optional :: kind
     logical, intent(in), optional :: force
-    integer :: j, comp, node(22), par(22), nw, ny, kd
-    real(dp) :: w(22), dir(3)
+    integer :: j, comp, node(22), par(22), nw, ny, kd, l, i
+    real(dp) :: w(22), dir(3), lg(3)
     logical :: at_force
     kd = 0
     if (present(kind)) kd = kind
@@ -394,6 +424,26 @@ contains
       do comp = 1, 3
         nd = nd + 1; d(nd) = dof(node(j), 3 + comp); v(nd) = w(j)*dir(comp)
       end do
+    end do
+    if (kd /= 0 .or. a%nl == 0) return
+    ! the lever D . dn on the positions n depends on: into the row's own entries where the
+    ! node has them, after them where not (the same parameters for the gap and the force)
+    do l = 1, a%nl
+      if (at_force) then
+        lg = a%lgradf(:, l)
+      else
+        lg = a%lgrad(:, l)
+      end if
+      i = findloc(node(1:ny), a%lnode(l), dim=1)
+      if (i > 0) then
+        do comp = 1, 3
+          v((comp - 1)*ny + i) = v((comp - 1)*ny + i) + lg(comp)
+        end do
+      else
+        do comp = 1, 3
+          nd = nd + 1; d(nd) = dof(a%lnode(l), comp); v(nd) = lg(comp)
+        end do
+      end if
     end do
   end subroutine constraint_row
 
@@ -444,10 +494,113 @@ contains
     con%xif = xi; con%shpf = shp
   end subroutine force_point
 
+  !> The gradient lg(:, 1:nl) of dv . con%n on the positions of the nodes lnode(1:nl) that
+  !> the target normal at con%xi depends on (con%side and xi held): the element's nodes, and
+  !> with nodal normals those of every element at them. Reverse mode through
+  !> n = u/|u|, u = sum_j N_j m_j/|m_j|, m_j = sum_e s_e t_e/|t_e|, t_e = a1 x a2 (the cubic
+  !> normal of element e at node j), gathered element by element. nl = 0 when the nodes
+  !> outnumber max_lever (or the elements max_elem).
+  subroutine normal_lever(c, model, x, con, dv, nl, lnode, lg, normals)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: x(:, :), dv(3)
+    type(constraint_t), intent(in) :: con
+    integer, intent(out) :: nl, lnode(max_lever)
+    real(dp), intent(out) :: lg(3, max_lever)
+    type(normal_cache_t), intent(in), optional :: normals   !< made by constraint_geometry
+    integer, parameter :: max_elem = 64
+    real(dp) :: shp(10), dphi(10, 2), u(3), bu(3), m(3, 10), own(3, 10), bm(3), t(3), ge(3, 10, max_elem)
+    integer :: j, i, nd, l, p, ne, el(max_elem), iv
+    real(dp) :: sg(10*max_elem)   ! (each visit's sign, the forward's for the backward)
+    nl = 0; ne = 0; iv = 0
+    call tri10_shape(con%xi(1), con%xi(2), shp, dphi)
+    associate (g => c%geo)
+      if (.not. c%nodal_normal) then
+        call back_normal(con%elem, dphi, con%side*dv, 1._dp)
+      else
+        u = 0
+        do j = 1, 10   ! (forward, as constraint_geometry)
+          nd = model%conn(j, con%elem)
+          own(:, j) = unit_at(con%elem, j)
+          m(:, j) = 0
+          do i = g%node_start(nd), g%node_start(nd + 1) - 1
+            t = unit_at(g%node_elem(i), g%node_loc(i))
+            iv = min(iv + 1, size(sg)); sg(iv) = sign(1._dp, dot_product(t, own(:, j)))
+            m(:, j) = m(:, j) + sg(iv)*t
+          end do
+          u = u + (shp(j)/norm2(m(:, j)))*m(:, j)
+        end do
+        bu = u/norm2(u)
+        bu = con%side*(dv - dot_product(dv, bu)*bu)/norm2(u)
+        if (iv == size(sg)) return
+        iv = 0
+        do j = 1, 10
+          nd = model%conn(j, con%elem)
+          t(1) = norm2(m(:, j)); m(:, j) = m(:, j)/t(1)
+          bm = shp(j)*(bu - dot_product(bu, m(:, j))*m(:, j))/t(1)
+          do i = g%node_start(nd), g%node_start(nd + 1) - 1
+            iv = iv + 1
+            call back_normal(g%node_elem(i), g%dphi_node(:, :, g%node_loc(i)), bm, sg(iv))
+          end do
+        end do
+      end if
+    end associate
+    if (ne > max_elem) return
+    do i = 1, ne   ! (the elements' gradients onto their nodes)
+      do l = 1, 10
+        nd = model%conn(l, el(i))
+        p = findloc(lnode(1:nl), nd, dim=1)
+        if (p == 0) then
+          if (nl == max_lever) then
+            nl = 0; return
+          end if
+          nl = nl + 1; lnode(nl) = nd; p = nl; lg(:, p) = 0
+        end if
+        lg(:, p) = lg(:, p) + ge(:, l, i)
+      end do
+    end do
+  contains
+    !> the unit normal of element e at its node k (the cache's, where it was made)
+    function unit_at(e, k) result(tn)
+      integer, intent(in) :: e, k
+      real(dp) :: tn(3)
+      if (present(normals)) then
+        if (normals%made(k, e)) then
+          tn = normals%n(:, k, e); return
+        end if
+      end if
+      tn = unit_normal(x(:, model%conn(:, e)), c%geo%dphi_node(:, :, k))
+    end function unit_at
+
+    !> add the gradient of b . s t/|t| (t element e's cubic normal where its shape
+    !> derivatives are ds) on e's nodes
+    subroutine back_normal(e, ds, b, s)
+      integer, intent(in) :: e
+      real(dp), intent(in) :: ds(10, 2), b(3), s
+      real(dp) :: a1(3), a2(3), tn(3), tl, bt(3), b1(3), b2(3)
+      integer :: k, q
+      if (ne > max_elem) return
+      q = findloc(el(1:ne), e, dim=1)
+      if (q == 0) then
+        ne = ne + 1
+        if (ne > max_elem) return
+        el(ne) = e; q = ne; ge(:, :, q) = 0
+      end if
+      a1 = matmul(x(:, model%conn(:, e)), ds(:, 1)); a2 = matmul(x(:, model%conn(:, e)), ds(:, 2))
+      tn = cross(a1, a2); tl = norm2(tn); tn = tn/tl
+      bt = s*(b - dot_product(b, tn)*tn)/tl
+      b1 = cross(a2, bt); b2 = cross(bt, a1)   ! b . (da1 x a2 + a1 x da2)
+      do k = 1, 10
+        ge(:, k, q) = ge(:, k, q) + ds(k, 1)*b1 + ds(k, 2)*b2
+      end do
+    end subroutine back_normal
+  end subroutine normal_lever
+
   !> The force acts at the gap's point until force_point finds its own
   pure subroutine hold_force_point(con)
     type(constraint_t), intent(inout) :: con
     con%xif = con%xi; con%shpf = con%shp; con%nf = con%n
+    con%wgf = con%wg; con%lgradf(:, 1:con%nl) = con%lgrad(:, 1:con%nl)
   end subroutine hold_force_point
 
   !> Unit normal of the cubic surface with node positions xe where the shape derivatives are dphi

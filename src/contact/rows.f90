@@ -5,7 +5,8 @@ module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_contact, only: contact_t, constraint_t, stick, slip, normal_compliance, normal_residual
-  use casca_contact_projection, only: constraint_entries, constraint_row, max_row, force_point
+  use casca_contact_projection, only: constraint_entries, constraint_row, max_row, force_point, positions, &
+                                      constraint_geometry, normal_cache_t, normal_cache
   use casca_obstacle, only: obstacle_point
   use casca_time_scheme, only: scheme_t
   use casca_lapack, only: dpotrf, dpotrs
@@ -37,14 +38,16 @@ contains
   !> stays at the gap's point, as in the thesis: Newmark does not keep L anyway, and with the
   !> force point Newton's symmetric saddle matrix converges only by fixed point (a
   !> self-contact crush stalled).
-  pure subroutine contact_force_points(c, model, af, q, qn)
+  subroutine contact_force_points(c, model, af, q, qn)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: af, q(:)
     real(dp), intent(in), optional :: qn(:)
-    real(dp), allocatable :: qf(:)
+    real(dp), allocatable :: qf(:), xf(:, :)
     real(dp) :: gm
     integer :: k, bt, nd
+    type(constraint_t) :: cf
+    type(normal_cache_t) :: normals
     if (.not. af > 0) return
     if (present(qn)) then
       qf = (1 - af)*q + af*qn
@@ -54,7 +57,24 @@ contains
     do k = 1, c%nact
       call force_point(model, qf, c%act(k))
       bt = c%pair(2, c%act(k)%pair)
-      if (bt > 0) cycle
+      if (bt > 0) then
+        if (c%act(k)%nl == 0) cycle
+        ! a normal row with its lever: the gap's gradient at qf (its point, side and faces
+        ! held), the midpoint rule's force for a work that is the gap's change over the step
+        if (.not. allocated(xf)) then
+          xf = positions(model, qf)
+          if (c%nodal_normal) call normal_cache(model, normals)
+        end if
+        cf = c%act(k)
+        if (c%nodal_normal) then
+          call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
+        else
+          call constraint_geometry(c, model, xf, qf, cf, lever=.true.)
+        end if
+        if (cf%nl /= c%act(k)%nl) cycle   ! (the same nodes; else the end's gradient)
+        c%act(k)%nf = cf%n; c%act(k)%wgf = cf%wg; c%act(k)%lgradf = cf%lgrad
+        cycle
+      end if
       ! an obstacle: its normal at the node's face point there (the midpoint rule's
       ! angular momentum about a cylinder's axis changes by x_mid x f, which n at the step's
       ! end, half a step's slide away, did not leave at zero: a ring spinning in a drum lost
@@ -106,8 +126,9 @@ contains
     integer :: k, j, m, nd, d(max_row), r, kind, nr, ns
     real(dp) :: v(max_row), vs(max_row), vf(max_row), mu
     nr = contact_nrows(c)
-    allocate (irn((max_row + 1)*nr), jcn((max_row + 1)*nr), val((max_row + 1)*nr), gap(nr), key(2, nr), &
-              fval((max_row + 1)*nr))
+    ! (entries: 66 for the points and fibres and a diagonal per row, the levers' beside)
+    m = sum([(67*constraint_nkinds(c%act(k)) + 3*c%act(k)%nl, k=1, c%nact)])
+    allocate (irn(m), jcn(m), val(m), gap(nr), key(2, nr), fval(m))
     m = 0; r = 0
     do k = 1, c%nact
       do kind = 0, constraint_nkinds(c%act(k)) - 1
@@ -120,7 +141,7 @@ contains
         key(:, r) = [4*c%act(k)%node + kind, c%act(k)%elem]
         call constraint_row(c%act(k), model, d, v, nd, kind)
         vf(1:nd) = v(1:nd)   ! (the force's own row only where it has its own point)
-        if (any(c%act(k)%shpf /= c%act(k)%shp) .or. any(c%act(k)%nf /= c%act(k)%n)) &
+        if (any(c%act(k)%shpf /= c%act(k)%shp) .or. any(c%act(k)%nf /= c%act(k)%n) .or. c%act(k)%nl > 0) &
           call constraint_row(c%act(k), model, d, vf, nd, kind, force=.true.)
         mu = 0; ns = 0
         if (kind == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
@@ -223,8 +244,9 @@ contains
   !> less the normal force of the constraints released taken out of it (newmark.f90);
   !> A_end = (F_end - alpha_m A_start)/(1 - alpha_m) with F_end the end forces (pair_forces
   !> as Newton left them: f_end); nu the velocity correction's impulses, in row order, along
-  !> the normals it took (Newmark: A_end = F_end). Every normal part is along nf, as the force
-  !> rows that applied it (build_rows; nf = n but on curved obstacles under generalized-alpha).
+  !> the normals it took (Newmark: A_end = F_end). Every normal part is along the normal of
+  !> the row that applied it: nf for the forces (n but on curved obstacles under
+  !> generalized-alpha, and with a lever), point_normal for the correction's (build_rows).
   !> (dt F_end summed over the steps is off by Newton's tolerance; this is exact.)
   subroutine add_step_impulse(c, ts, released, nu, f_end)
     type(contact_t), intent(inout) :: c
@@ -236,15 +258,15 @@ contains
     dt = ts%dt; g = ts%gamma
     do k = 1, size(released)
       associate (a => released(k))
-        c%carry(:, a%pair) = c%carry(:, a%pair) - (a%mu - a%lambda/(1 - ts%alpha_m))*a%nf
+        c%carry(:, a%pair) = c%carry(:, a%pair) - a%mu*point_normal(a) + a%lambda/(1 - ts%alpha_m)*a%nf
       end associate
     end do
     j = 0; mu = 0
     r = 0
     do k = 1, c%nact
       associate (a => c%act(k))
-        j(:, a%pair) = j(:, a%pair) + nu(r + 1)*a%nf
-        mu(:, a%pair) = mu(:, a%pair) + a%mu*a%nf
+        j(:, a%pair) = j(:, a%pair) + nu(r + 1)*point_normal(a)
+        mu(:, a%pair) = mu(:, a%pair) + a%mu*point_normal(a)
         if (a%grip == stick) then
           j(:, a%pair) = j(:, a%pair) + nu(r + 2)*a%t(:, 1) + nu(r + 3)*a%t(:, 2)
           mu(:, a%pair) = mu(:, a%pair) + a%mut(1)*a%t(:, 1) + a%mut(2)*a%t(:, 2)
@@ -326,6 +348,14 @@ contains
       end if
     end function y_of
   end subroutine start_carry
+
+  !> The normal the velocity correction's row takes on the node (row_factors' point): n with
+  !> a lever (nf is then the force's, at the scheme's internal-force configuration), else nf
+  pure function point_normal(a) result(n)
+    type(constraint_t), intent(in) :: a
+    real(dp) :: n(3)
+    n = merge(a%n, a%nf, a%nl > 0)
+  end function point_normal
 
   !> The contact force on the constraint's node: normal and friction
   pure function node_force(c, a) result(f)

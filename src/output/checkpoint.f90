@@ -13,7 +13,7 @@ module casca_checkpoint
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t
   use casca_newmark, only: state_t
-  use casca_contact, only: contact_t, constraint_t
+  use casca_contact, only: contact_t, new_constraint
   use casca_contact_projection, only: positions, constraint_geometry
   use casca_hdf5_io, only: write_checkpoint, read_checkpoint
   use casca_mpi, only: is_root
@@ -286,7 +286,7 @@ contains
     end if
     with_fa = size(reals) == 14*int(nact, int64) + 7*contact%npairs + 1   ! (friction's start forces)
     do k = 1, nact
-      contact%act(k) = constraint_t(node=ints(3 + per*(k - 1)), pair=ints(4 + per*(k - 1)))
+      contact%act(k) = new_constraint(ints(3 + per*(k - 1)), ints(4 + per*(k - 1)))
       contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
       if (per == 2) cycle   ! (elem = 0: projected again at the first step)
       contact%act(k)%elem = ints(5 + per*(k - 1))
@@ -306,7 +306,7 @@ contains
       ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
       ! that wrote it left them
       if (contact%act(k)%elem > 0 .or. contact%pair(2, contact%act(k)%pair) <= 0) &
-        call constraint_geometry(contact, model, positions(model, st%q), st%q, contact%act(k))
+        call constraint_geometry(contact, model, positions(model, st%q), st%q, contact%act(k), lever=.true.)
     end do
   contains
     !> the checksum of what was read (the pressure work with the reals, as save_checkpoint)
