@@ -178,11 +178,16 @@ contains
     end subroutine push
   end subroutine contact_update
 
-  !> A new solve of a step: no active-set change yet
+  !> A new solve of a step: no active-set change yet; the sliding directions it starts from
   subroutine contact_solve_start(c)
     type(contact_t), intent(inout) :: c
+    integer :: k
     c%changes = 0
+    c%follow_slip = .false.; c%hold_slip = .false.
     c%act(1:c%nact)%flips = 0
+    do k = 1, c%nact
+      c%act(k)%s0 = c%act(k)%s
+    end do
   end subroutine contact_solve_start
 
   !> Where Newton has converged for the set: stick/slip changes first, else releases and new

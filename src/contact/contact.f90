@@ -19,7 +19,7 @@ module casca_contact
   private
   public :: contact_t, constraint_t, target_geometry_t, contact_init, face_reach, search_radius
   public :: contact_set_stiffness, normal_compliance, normal_residual, holds, tested_both_ways
-  public :: new_constraint
+  public :: new_constraint, slip_followed
 
   !> Most nodes a target normal depends on (the elements around its element's 10 nodes:
   !> about 70 on a mesh of valence 6); a constraint with more leaves its lever out
@@ -62,7 +62,10 @@ module casca_contact
     real(dp) :: lt(2) = 0       !< stick multipliers: the force on the node is -lt(1) t1 - lt(2) t2
     real(dp) :: mut(2) = 0      !< their acceleration correction
     real(dp) :: gt(2) = 0       !< stick rows' gaps: relative tangential displacement in the step
-    real(dp) :: s(3) = 0        !< slip direction of the node relative to the target, held
+    !> slip direction of the node relative to the target: its slip over the step at the last
+    !> iterate (friction_geometry), held while that slip is below slip_floor
+    real(dp) :: s(3) = 0
+    real(dp) :: s0(3) = 0       !< s at the solve's start (a slip that turns against it stopped)
     real(dp) :: ut(3) = 0       !< relative tangential displacement in the step
     real(dp) :: u0(3) = 0       !< (stick_at_touch) its part before the contact was made
     !> the friction force on the node at the step's start (the last step's end), for its work
@@ -71,6 +74,7 @@ module casca_contact
   end type constraint_t
 
   integer, parameter, public :: stick = 1, slip = 2
+  real(dp), parameter :: slip_share = 1e-8_dp   !< slip_floor over the scene size
 
   !> The target bodies' surfaces as the search and the normals need them.
   type :: target_geometry_t
@@ -109,6 +113,14 @@ module casca_contact
     real(dp), allocatable :: mu_d(:), mu_s(:)
     real(dp), allocatable :: x_start(:, :), g_start(:, :)   !< positions and fibres
     real(dp) :: dt = 0
+    !> a slip over the step shorter than this [m] does not turn s: its direction is Newton's
+    !> round-off (tol = 1e-10 of the scene size), and the sliding force's stiffness across it,
+    !> mu_d |lambda| / |ut|, would turn the rows hard (a trial without this floor met slips of
+    !> 1e-19 m at slip onset, and singular Schur complements)
+    real(dp) :: slip_floor = 0
+    !> sliding directions follow the slip at this iterate (Newton sets it once an iterate is
+    !> near); else each holds its last. hold_slip: not in this solve (friction_hold)
+    logical :: follow_slip = .false., hold_slip = .false.
     !> statics: a contact made in a load increment sticks where it touched, not where its node
     !> was at the increment's start (a cantilever's tip slides a long way before it touches)
     logical :: stick_at_touch = .false.
@@ -166,6 +178,7 @@ contains
     end do
     allocate (c%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
     c%mu_d = 0; c%mu_s = 0; c%friction_work = 0
+    c%slip_floor = slip_share*model%length
     allocate (c%impulse(3, c%npairs), c%carry(3, c%npairs))
     c%impulse = 0; c%carry = 0
     associate (g => c%geo)
@@ -250,6 +263,18 @@ contains
     c%compliance = 1/(stiffness*max(area, tiny(1._dp)))
     c%compliant = .true.
   end subroutine contact_set_stiffness
+
+  !> Whether sliding constraint a's direction s follows its slip ut at this iterate: the slip
+  !> is past the slip floor and still along s0, the way it went at the solve's start (a slip
+  !> that turns against it stopped, and sticks at convergence, friction_update: following
+  !> it, s would turn round with it and Newton cycle, as a block stopping on a floor did)
+  pure logical function slip_followed(c, a)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    slip_followed = .false.
+    if (c%follow_slip .and. a%grip == slip) &
+      slip_followed = norm2(a%ut) >= c%slip_floor .and. norm2(a%ut) > 0 .and. dot_product(a%ut, a%s0) > 0
+  end function slip_followed
 
   !> Whether the active set holds a constraint of node on pair p
   pure logical function holds(c, node, p)

@@ -1,16 +1,19 @@
 !> Coulomb friction on the active constraints (static coefficient mu_s, dynamic mu_d per
 !> pair). A constraint sticks (two Lagrange rows: no relative tangential displacement over
-!> the step) or slides (a force mu_d |lambda| against its slip direction s, held through the
-!> step). The return mapping between the two is an active-set change, made where Newton has
-!> converged, like the release of a tensile multiplier:
+!> the step) or slides (a force mu_d |lambda| against its slip direction s: the slip over
+!> the step at each Newton iterate, friction_geometry, with its stiffness across s in
+!> Newton's rows, contact_rows; held while the slip is below the slip floor). The return
+!> mapping between the two is an active-set change, made where Newton has converged, like
+!> the release of a tensile multiplier:
 !>   stick -> slip  when the stick force exceeds mu_s |lambda|; s along the stick force's
 !>                  opposite (the way the node would go);
-!>   slip -> stick  when the node's relative slip over the step turns against s (it stopped).
+!>   slip -> stick  when the node's relative slip over the step turns against s0, s at the
+!>                  solve's start (it stopped: s itself follows the slip).
 !> A constraint that went from slip back to stick in a step and is pushed past the cone again
 !> slides for the rest of the step (its direction from the last stick force): the step ends
 !> inside Coulomb's cone rather than cycling (a sliding ring's contact node did).
-!> After an accepted step a sliding constraint takes its step's slip direction for the next
-!> and adds its force times its slip to the pair's dissipated energy.
+!> After an accepted step a sliding constraint adds its force times its slip to the pair's
+!> dissipated energy and takes its step's slip direction for the next.
 module casca_contact_friction
   use casca_kinds, only: dp
   use casca_contact, only: contact_t, constraint_t, stick, slip, holds
@@ -18,7 +21,7 @@ module casca_contact_friction
   use casca_time_scheme, only: scheme_t
   implicit none
   private
-  public :: friction_on, friction_update, friction_step_done, pair_tangential_force
+  public :: friction_on, friction_update, friction_hold, friction_step_done, pair_tangential_force
 
 contains
 
@@ -42,11 +45,11 @@ contains
         case (stick)
           f = a%lt(1)*a%t(:, 1) + a%lt(2)*a%t(:, 2)   ! minus the stick force on the node
           if (norm2(f) > c%mu_s(a%pair)*max(-a%lambda, 0._dp)) then
-            a%grip = slip; a%s = f/norm2(f); a%lt = 0
+            a%grip = slip; a%s = f/norm2(f); a%s0 = a%s; a%lt = 0
             changed = changed + 1; a%flips = a%flips + 1
           end if
         case (slip)
-          if (dot_product(a%ut, a%s) < 0 .and. a%flips < 2) then
+          if (dot_product(a%ut, a%s0) < 0 .and. a%flips < 2) then
             a%grip = stick; a%lt = 0
             changed = changed + 1; a%flips = a%flips + 1
           end if
@@ -56,8 +59,21 @@ contains
     if (changed > 0) c%changes = c%changes + 1
   end subroutine friction_update
 
-  !> After an accepted step (scheme ts): sliding constraints add their work and turn s to
-  !> their slip. Newmark takes the force at the step's end and its velocity update spreads it
+  !> The sliding directions are held for the rest of the solve, each at its solve's start
+  !> (s0), as before they followed the slip: Newton gives up following it where it does not
+  !> converge so (nodes whose slip in the step is a hundredth of their motion, about to
+  !> stick, turned theirs by a radian from iterate to iterate: a ball rattling in a shell)
+  subroutine friction_hold(c)
+    type(contact_t), intent(inout) :: c
+    integer :: k
+    c%follow_slip = .false.; c%hold_slip = .true.
+    do k = 1, c%nact
+      if (c%act(k)%grip == slip) c%act(k)%s = c%act(k)%s0
+    end do
+  end subroutine friction_hold
+
+  !> After an accepted step (scheme ts): sliding constraints add their work and take their
+  !> step's slip direction for the next (s has it already unless it was held). Newmark takes the force at the step's end and its velocity update spreads it
   !> over two steps, (1 - gamma) F_start + gamma F_end in this one: that is the force the
   !> work is counted with (the end force alone lags the kinetic energy by a step where the
   !> force jumps, as it does each time a rolling hoop hands its contact to the next node: the
@@ -92,8 +108,7 @@ contains
   end subroutine friction_step_done
 
   !> Per pair: the magnitude of the resultant tangential (friction) force on its impactor, as
-  !> it acted at the end of the last step (fa: friction_step_done has since turned the
-  !> sliding constraints' directions to their slip)
+  !> it acted at the end of the last step (fa)
   pure function pair_tangential_force(c) result(ft)
     type(contact_t), intent(in) :: c
     real(dp) :: ft(c%npairs), f(3, c%npairs)

@@ -11,7 +11,7 @@
 !>
 !> With Coulomb friction a sticking constraint has two more rows, the relative tangential
 !> displacement of the node over the step (along t1, t2 across n), and a sliding one carries
-!> a known force mu_d |lambda| against its slip direction s, held through the step.
+!> a force mu_d |lambda| against its slip direction s, the slip's at each iterate.
 
 module casca_contact_projection
   use casca_kinds, only: dp
@@ -22,7 +22,8 @@ module casca_contact_projection
   use casca_obstacle, only: obstacle_point
   use casca_closest_point, only: region_face, region_edge_ab, region_edge_bc, region_edge_ca, &
                                  region_vertex_a, region_vertex_b, region_vertex_c
-  use casca_contact, only: contact_t, constraint_t, search_radius, tested_both_ways, max_lever
+  use casca_contact, only: contact_t, constraint_t, search_radius, tested_both_ways, max_lever, &
+                           slip_followed
   implicit none
   private
   public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face, &
@@ -38,6 +39,7 @@ module casca_contact_projection
   end type normal_cache_t
 
   integer, parameter, public :: max_row = 66 + 3*max_lever   !< 11 nodes x (Y, G), the lever's nodes
+  integer, parameter, public :: across = 4     !< the row kind across the slip (row_factors)
 
 contains
 
@@ -269,6 +271,10 @@ contains
       u = u - con%u0
       con%ut = u - dot_product(u, con%n)*con%n
       con%gt = [dot_product(u, con%t(:, 1)), dot_product(u, con%t(:, 2))]
+      ! a sliding force is against the slip of this iterate, not of the step before: held
+      ! through the step, s lagged a step, and where mu_d |lambda| / |ut| is as stiff as
+      ! the node (a ball glancing down a slope) the lag overshot, growing 1.65 times a step
+      if (slip_followed(c, con)) con%s = con%ut/norm2(con%ut)
     end subroutine friction_geometry
 
     !> the change of node k's fibre over the step
@@ -346,7 +352,7 @@ contains
   !> direction: C_row = sum_j w(j) e(node(j), par(j)) (x) dir, par 0 the mid-surface point Y,
   !> 1 the fibre G (the Y entries first). kind 0: the normal row along n; kind 1, 2: the stick
   !> rows along t1, t2; kind 3: along the slip direction s (the sliding force's, mu_d |lambda|
-  !> on it). Each acts on the mid-surface points and, between faces, on the fibres that carry
+  !> on it); kind 4 (across): across s in the tangent plane, n x s. Each acts on the mid-surface points and, between faces, on the fibres that carry
   !> the offset: the faces touch, and stick or slide, where they are. force: the row as the
   !> force acts, at shpf, friction included (at the gap's point, half a step's slide away,
   !> the friction pair had a moment: a spinning ball rattling in a shell lost 2.9e-4 of L
@@ -369,6 +375,9 @@ contains
     select case (kind)
     case (0); dir = merge(a%nf, a%n, force)
     case (1, 2); dir = a%t(:, kind)
+    case (across)
+      dir = cross(a%n, a%s)
+      if (norm2(dir) > 0) dir = dir/norm2(dir)
     case default; dir = a%s
     end select
     ! a normal row with its lever is the gap's gradient itself, where the force is taken too

@@ -1,18 +1,20 @@
 !> The active constraints as the equations see them: the rows of C for the saddle point (one
-!> per constraint, two more for a sticking one), their multipliers, and the contact forces
-!> C^T lambda they carry (with the sliding ones' friction).
+!> per constraint, two more for a sticking one, one more in Newton's system for a sliding
+!> one), their multipliers, and the contact forces C^T lambda they carry (with the sliding
+!> ones' friction).
 module casca_contact_rows
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_contact, only: contact_t, constraint_t, stick, slip, normal_compliance, normal_residual
+  use casca_contact, only: contact_t, constraint_t, stick, slip, normal_compliance, normal_residual, &
+                           slip_followed
   use casca_contact_projection, only: constraint_entries, constraint_row, max_row, force_point, positions, &
-                                      constraint_geometry, normal_cache_t, normal_cache
+                                      constraint_geometry, normal_cache_t, normal_cache, across
   use casca_obstacle, only: obstacle_point
   use casca_time_scheme, only: scheme_t
   use casca_lapack, only: dpotrf, dpotrs
   implicit none
   private
-  public :: contact_nrows, contact_rows, contact_multipliers, contact_set_multipliers
+  public :: contact_nrows, contact_newton_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
   public :: contact_stored_energy
   public :: constraint_nkinds, slip_force, friction_force, add_step_impulse, pair_forces, contact_force_points
@@ -32,6 +34,13 @@ contains
     integer :: k
     contact_nrows = sum([(constraint_nkinds(c%act(k)), k=1, c%nact)])
   end function contact_nrows
+
+  !> Number of rows of Newton's system: the active set's, and one across the slip of each
+  !> sliding constraint (contact_rows)
+  pure integer function contact_newton_nrows(c)
+    type(contact_t), intent(in) :: c
+    contact_newton_nrows = contact_nrows(c) + count(c%act(1:c%nact)%grip == slip)
+  end function contact_newton_nrows
 
   !> Every active constraint's force point (force_point) where the scheme takes the
   !> internal force, (1 - af) q + af qn (at q without qn). With af = 0 (Newmark) the force
@@ -85,17 +94,21 @@ contains
     end do
   end subroutine contact_force_points
 
-  !> The multipliers of every row, in row order
+  !> The multipliers of every row of Newton's system, in row order (0 across a slip: that
+  !> row's multiplier is an increment's only, contact_rows)
   pure function contact_multipliers(c) result(lam)
     type(contact_t), intent(in) :: c
     real(dp), allocatable :: lam(:)
     integer :: k, r
-    allocate (lam(contact_nrows(c)))
+    allocate (lam(contact_newton_nrows(c)))
     r = 0
     do k = 1, c%nact
       r = r + 1; lam(r) = c%act(k)%lambda
-      if (c%act(k)%grip /= stick) cycle
-      lam(r + 1:r + 2) = c%act(k)%lt; r = r + 2
+      if (c%act(k)%grip == stick) then
+        lam(r + 1:r + 2) = c%act(k)%lt; r = r + 2
+      else if (c%act(k)%grip == slip) then
+        r = r + 1; lam(r) = 0
+      end if
     end do
   end function contact_multipliers
 
@@ -106,8 +119,11 @@ contains
     r = 0
     do k = 1, c%nact
       r = r + 1; c%act(k)%lambda = lam(r)
-      if (c%act(k)%grip /= stick) cycle
-      c%act(k)%lt = lam(r + 1:r + 2); r = r + 2
+      if (c%act(k)%grip == stick) then
+        c%act(k)%lt = lam(r + 1:r + 2); r = r + 2
+      else if (c%act(k)%grip == slip) then
+        r = r + 1
+      end if
     end do
   end subroutine contact_set_multipliers
 
@@ -117,28 +133,43 @@ contains
   !> fval: the same entries of the columns the multipliers act through: C^T where the force
   !> acts (force_point), and for a sliding constraint's normal row n - mu_d s there
   !> (its friction follows |lambda|).
+  !> A sliding constraint's force turns with its slip (s = ut / |ut|, friction_geometry):
+  !> across s it is as stiff as k = mu_d |lambda| / |ut|, which Newton needs (without it
+  !> the turn overshoots where k is as stiff as the node). That stiffness, k B_e^T C_e (e
+  !> across s, B at the force's point, C at the gap's), is the row across s with compliance
+  !> 1/k and no gap: eliminated, its multiplier adds it to K. The multiplier is an
+  !> increment's only (0 at each iterate, contact_multipliers): the force it stands for is
+  !> in s's turn at the next iterate. Where s is held (slip_stiffness 0) the row is empty
+  !> with compliance 1, its multiplier 0.
   subroutine contact_rows(c, model, eq, neq, irn, jcn, val, gap, key, fval)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     integer, intent(in) :: eq(:), neq
     integer, allocatable, intent(out) :: irn(:), jcn(:), key(:, :)
     real(dp), allocatable, intent(out) :: val(:), gap(:), fval(:)
-    integer :: k, j, m, nd, d(max_row), r, kind, nr, ns
-    real(dp) :: v(max_row), vs(max_row), vf(max_row), mu
-    nr = contact_nrows(c)
-    ! (entries: 66 for the points and fibres and a diagonal per row, the levers' beside)
-    m = sum([(67*constraint_nkinds(c%act(k)) + 3*c%act(k)%nl, k=1, c%nact)])
+    integer :: k, j, m, nd, d(max_row), r, kind, nr, ns, i
+    real(dp) :: v(max_row), vs(max_row), vf(max_row), mu, ks, w
+    nr = contact_newton_nrows(c)
+    ! (entries: 66 for the points and fibres and a diagonal per row, one more row across a
+    ! slip, the levers' beside)
+    m = sum([(67*(constraint_nkinds(c%act(k)) + merge(1, 0, c%act(k)%grip == slip)) + 3*c%act(k)%nl, &
+              k=1, c%nact)])
     allocate (irn(m), jcn(m), val(m), gap(nr), key(2, nr), fval(m))
     m = 0; r = 0
     do k = 1, c%nact
-      do kind = 0, constraint_nkinds(c%act(k)) - 1
+      do i = 0, constraint_nkinds(c%act(k)) - merge(0, 1, c%act(k)%grip == slip)
+        kind = i
+        if (c%act(k)%grip == slip .and. i == 1) kind = across
         r = r + 1
         if (kind == 0) then   ! (compliant: g - lambda / k, contact_set_stiffness)
           gap(r) = normal_residual(c, c%act(k))
+        else if (kind == across) then
+          gap(r) = 0
         else
           gap(r) = c%act(k)%gt(kind)
         end if
         key(:, r) = [4*c%act(k)%node + kind, c%act(k)%elem]
+        if (kind == across) key(1, r) = -(4*c%act(k)%node + 3)   ! (apart from every other row)
         call constraint_row(c%act(k), model, d, v, nd, kind)
         vf(1:nd) = v(1:nd)   ! (the force's own row only where it has its own point)
         if (any(c%act(k)%shpf /= c%act(k)%shp) .or. any(c%act(k)%nf /= c%act(k)%n) .or. c%act(k)%nl > 0) &
@@ -148,17 +179,35 @@ contains
           mu = c%mu_d(c%act(k)%pair); key(1, r) = 4*c%act(k)%node + 3
           call constraint_row(c%act(k), model, d, vs, ns, 3, force=.true.)   ! (the same points first)
         end if
+        w = 1   ! (the row's weight: 0 for an empty row across a held s)
+        if (kind == across) then
+          ks = slip_stiffness(c, c%act(k))
+          if (.not. ks > 0) w = 0
+        end if
         do j = 1, nd
           if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
-          m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = v(j); fval(m) = vf(j)
+          m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = w*v(j); fval(m) = w*vf(j)
           if (j <= ns) fval(m) = vf(j) - mu*vs(j)
         end do
         m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
         if (kind == 0) val(m) = -normal_compliance(c, c%act(k))
+        if (kind == across) then
+          val(m) = -1
+          if (w > 0) val(m) = -1/ks
+        end if
       end do
     end do
     irn = irn(1:m); jcn = jcn(1:m); val = val(1:m); fval = fval(1:m)
   end subroutine contact_rows
+
+  !> The sliding force's stiffness across its slip, mu_d |lambda| / |ut|, where s follows the
+  !> slip (friction_geometry); 0 where s is held or the force is 0
+  pure real(dp) function slip_stiffness(c, a)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    slip_stiffness = 0
+    if (slip_followed(c, a)) slip_stiffness = slip_force(c, a)/norm2(a%ut)
+  end function slip_stiffness
 
   !> The sliding force's multiplier on the row along s: mu_d |lambda| (0 unless sliding)
   pure real(dp) function slip_force(c, a)

@@ -29,9 +29,10 @@ module casca_newton
   use casca_pressure_assembly, only: add_pressure   ! follower pressure (issue 17)
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
                                  kkt_solve, negative_pivots, follow_bodies
-  use casca_contact, only: contact_t, constraint_t
+  use casca_contact, only: contact_t, constraint_t, slip
   use casca_contact_active_set, only: contact_update, contact_settle, contact_solve_start
-  use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_nrows, &
+  use casca_contact_friction, only: friction_hold
+  use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_newton_nrows, &
                                 contact_multipliers, contact_set_multipliers, contact_max_gap, &
                                 contact_force_points
   use casca_mpi, only: is_root, sum_all
@@ -49,6 +50,9 @@ module casca_newton
   !> set to tol before that took a ring thrown at a wall at 100 m/s 1,315 Newton iterations in
   !> 0.6 ms, now 979
   real(dp), parameter :: settle_incr = 1e-3_dp
+  !> iterations within which Newton converges once the sliding directions follow the slip,
+  !> else they are held (follow_slip_when_near)
+  integer, parameter :: follow_iters = 8
   !> in dynamics the iterate's error is also within this share of the step's motion, but
   !> need not go below floor_share of tol (round-off; a body at rest): step_tol
   real(dp), parameter :: step_share = 1e-4_dp, floor_share = 1e-3_dp
@@ -110,6 +114,7 @@ contains
     type(increment_t) :: inc
     integer :: it, it_set, nc, version
     integer :: set_start   !< the first increment of the current active set
+    integer :: follow_start   !< the iteration after which the sliding directions followed the slip
     real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
     real(dp) :: taken(max_hist)   !< rep%incr before any line-search shortening
     logical :: fresh, refresh_next
@@ -160,6 +165,7 @@ contains
       call take_increment()
       if (allocated(err)) exit
       if (refresh_next) cycle   ! (the increment was undone)
+      call follow_slip_when_near()
       if (.not. small_enough(rep, step_tol(opts%tol, q, model%length, qn))) then
         if (near_enough(rep, set_start, contact)) then
           if (set_changed(stick=.false.)) call new_set()
@@ -168,6 +174,7 @@ contains
         cycle
       end if
       if (residual_estimate() > max(opts%force_tol*fref, ffloor)) cycle
+      if (slip_held()) cycle
       if (set_changed(stick=.true.)) then
         if (allocated(err)) exit
         call new_set()
@@ -198,7 +205,7 @@ contains
       if (present(contact)) then
         call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
                             reproject=reproject)
-        nc = contact_nrows(contact)
+        nc = contact_newton_nrows(contact)
         if (present(qn) .and. present(af)) call contact_force_points(contact, model, af, q, qn)
         call contact_rows(contact, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, &
                           rows%key, rows%fval)
@@ -310,7 +317,44 @@ contains
     subroutine new_set()
       it_set = 0
       set_start = rep%nincr + 1
+      if (present(contact)) contact%follow_slip = .false.
     end subroutine new_set
+
+    !> Sliding directions follow the slip (friction_geometry) from the first iterate of a set
+    !> that is near, as settle_incr decides the active set: from the far ones (a step's
+    !> predictor, a new contact) they swung by a radian from iterate to iterate, and Newton
+    !> cycled (a ball sliding inside a shell)
+    !> (follow_iters iterations after that without convergence, they are held at the
+    !> solve's start for the rest of it: friction_hold)
+    subroutine follow_slip_when_near()
+      if (.not. present(contact)) return
+      if (contact%hold_slip) return
+      if (contact%follow_slip) then
+        if (it - follow_start >= follow_iters) then
+          call friction_hold(contact); inc%set = -1
+        end if
+        return
+      end if
+      if (rep%nincr < set_start + 1) return
+      if (rep%incr(rep%nincr) <= settle_incr .and. contraction(rep) < 1) call follow()
+    end subroutine follow_slip_when_near
+
+    !> the sliding directions follow the slip from the next iterate
+    subroutine follow()
+      contact%follow_slip = .true.; follow_start = it
+      inc%set = -1   ! (the residual's change is not the increment's)
+    end subroutine follow
+
+    !> Converged with the sliding directions held (a set that converged before it was near):
+    !> they follow the slip from here, and Newton goes on
+    logical function slip_held()
+      slip_held = .false.
+      if (.not. present(contact)) return
+      if (contact%follow_slip .or. contact%hold_slip) return
+      if (.not. any(contact%act(1:contact%nact)%grip == slip)) return
+      call follow()
+      slip_held = .true.
+    end function slip_held
 
     !> converged for this set: stick/slip, releases and new penetrations (contact_settle;
     !> stick = .false.: near, not converged, stick and slip left for later). True when the
