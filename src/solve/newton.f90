@@ -51,7 +51,7 @@ module casca_newton
   !> 0.6 ms, now 979
   real(dp), parameter :: settle_incr = 1e-3_dp
   !> iterations within which Newton converges once the sliding directions follow the slip,
-  !> else they are held (follow_slip_when_near)
+  !> else they are held (slip_rule_changed)
   integer, parameter :: follow_iters = 8
   !> in dynamics the iterate's error is also within this share of the step's motion, but
   !> need not go below floor_share of tol (round-off; a body at rest): step_tol
@@ -165,7 +165,9 @@ contains
       call take_increment()
       if (allocated(err)) exit
       if (refresh_next) cycle   ! (the increment was undone)
-      call follow_slip_when_near()
+      if (present(contact)) then   ! (a new rule: the residual's change is not the increment's)
+        if (slip_rule_changed(contact, it, settling(rep, set_start), follow_start)) inc%set = -1
+      end if
       if (.not. small_enough(rep, step_tol(opts%tol, q, model%length, qn))) then
         if (near_enough(rep, set_start, contact)) then
           if (set_changed(stick=.false.)) call new_set()
@@ -174,7 +176,11 @@ contains
         cycle
       end if
       if (residual_estimate() > max(opts%force_tol*fref, ffloor)) cycle
-      if (slip_held()) cycle
+      if (present(contact)) then
+        if (slip_held(contact, it, follow_start)) then
+          inc%set = -1; cycle
+        end if
+      end if
       if (set_changed(stick=.true.)) then
         if (allocated(err)) exit
         call new_set()
@@ -320,42 +326,6 @@ contains
       if (present(contact)) contact%follow_slip = .false.
     end subroutine new_set
 
-    !> Sliding directions follow the slip (friction_geometry) from the first iterate of a set
-    !> that is near, as settle_incr decides the active set: from the far ones (a step's
-    !> predictor, a new contact) they swung by a radian from iterate to iterate, and Newton
-    !> cycled (a ball sliding inside a shell)
-    !> (follow_iters iterations after that without convergence, they are held at the
-    !> solve's start for the rest of it: friction_hold)
-    subroutine follow_slip_when_near()
-      if (.not. present(contact)) return
-      if (contact%hold_slip) return
-      if (contact%follow_slip) then
-        if (it - follow_start >= follow_iters) then
-          call friction_hold(contact); inc%set = -1
-        end if
-        return
-      end if
-      if (rep%nincr < set_start + 1) return
-      if (rep%incr(rep%nincr) <= settle_incr .and. contraction(rep) < 1) call follow()
-    end subroutine follow_slip_when_near
-
-    !> the sliding directions follow the slip from the next iterate
-    subroutine follow()
-      contact%follow_slip = .true.; follow_start = it
-      inc%set = -1   ! (the residual's change is not the increment's)
-    end subroutine follow
-
-    !> Converged with the sliding directions held (a set that converged before it was near):
-    !> they follow the slip from here, and Newton goes on
-    logical function slip_held()
-      slip_held = .false.
-      if (.not. present(contact)) return
-      if (contact%follow_slip .or. contact%hold_slip) return
-      if (.not. any(contact%act(1:contact%nact)%grip == slip)) return
-      call follow()
-      slip_held = .true.
-    end function slip_held
-
     !> converged for this set: stick/slip, releases and new penetrations (contact_settle;
     !> stick = .false.: near, not converged, stick and slip left for later). True when the
     !> set changed; an error when it keeps changing.
@@ -380,6 +350,41 @@ contains
     end function gap_open
 
   end subroutine newton_solve
+
+  !> Sliding directions follow the slip (friction_geometry) from the first iterate of a set
+  !> that is near, as settle_incr decides the active set: from the far ones (a step's
+  !> predictor, a new contact) they swung by a radian from iterate to iterate, and Newton
+  !> cycled (a ball sliding inside a shell). follow_iters iterations after that without
+  !> convergence, they are held at the solve's start for the rest of it (friction_hold).
+  !> True when the rule changed at this iterate it.
+  logical function slip_rule_changed(contact, it, near, follow_start) result(changed)
+    type(contact_t), intent(inout) :: contact
+    integer, intent(in) :: it
+    logical, intent(in) :: near
+    integer, intent(inout) :: follow_start   !< the iterate after which they followed
+    changed = .false.
+    if (contact%hold_slip) return
+    if (contact%follow_slip) then
+      if (it - follow_start >= follow_iters) then
+        call friction_hold(contact); changed = .true.
+      end if
+    else if (near) then
+      contact%follow_slip = .true.; follow_start = it; changed = .true.
+    end if
+  end function slip_rule_changed
+
+  !> Converged with the sliding directions held (a set that converged before it was near):
+  !> they follow the slip from here, and Newton goes on
+  logical function slip_held(contact, it, follow_start)
+    type(contact_t), intent(inout) :: contact
+    integer, intent(in) :: it
+    integer, intent(inout) :: follow_start
+    slip_held = .false.
+    if (contact%follow_slip .or. contact%hold_slip) return
+    if (.not. any(contact%act(1:contact%nact)%grip == slip)) return
+    contact%follow_slip = .true.; follow_start = it
+    slip_held = .true.
+  end function slip_held
 
   !> A new matrix unless the kept one still contracts the increment fast enough (decided
   !> from replicated figures, so alike on every rank). With constraints, slow contraction
@@ -459,10 +464,19 @@ contains
     integer, intent(in) :: set_start
     type(contact_t), intent(in), optional :: contact
     near_enough = .false.
-    if (.not. present(contact) .or. rep%nincr < set_start + 1) return
+    if (.not. present(contact)) return
     if (contact%changes >= max_set_changes/2) return
-    near_enough = rep%incr(rep%nincr) <= settle_incr .and. contraction(rep) < 1
+    near_enough = settling(rep, set_start)
   end function near_enough
+
+  !> The increments of the set (from its first, set_start) contract, the last within
+  !> settle_incr
+  logical pure function settling(rep, set_start)
+    type(newton_report_t), intent(in) :: rep
+    integer, intent(in) :: set_start
+    settling = .false.
+    if (rep%nincr >= set_start + 1) settling = rep%incr(rep%nincr) <= settle_incr .and. contraction(rep) < 1
+  end function settling
 
   !> Force of the inertia of the heaviest element moved by tol of the scene size in one step
   !> (cm: the inertia's factor): below it the residual is round-off of the inertial terms
