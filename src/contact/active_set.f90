@@ -7,7 +7,7 @@ module casca_contact_active_set
   use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds, new_constraint
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry, normal_cache_t, &
                                       normal_cache
-  use casca_contact_friction, only: friction_on, friction_update
+  use casca_contact_friction, only: friction_on, beyond_cone, friction_update
   implicit none
   private
   public :: contact_update, contact_release, contact_settle, contact_solve_start
@@ -207,19 +207,24 @@ contains
     changed = 0
     if (stick) call friction_update(c, changed)
     if (changed > 0) return
-    call contact_release(c, released)
+    call contact_release(c, released, keep_stuck=.not. stick)
     call contact_update(c, model, q, .true., added, reproject=.false.)
     changed = released + added
   end subroutine contact_settle
 
   !> Release the constraints whose multiplier is tensile (lambda > 0); how many were released.
-  subroutine contact_release(c, released)
+  !> keep_stuck: not a sticking one outside Coulomb's cone (at an iterate that is not
+  !> converged, where stick and slip wait): its tension may come from the stick force alone
+  !> (a plate landing flat while it spins, every node stuck at first: the stick forces at the
+  !> bottom face tilted it, and half its nodes were released, taken again, released...)
+  subroutine contact_release(c, released, keep_stuck)
     type(contact_t), intent(inout) :: c
     integer, intent(out) :: released
+    logical, intent(in) :: keep_stuck
     integer :: k, m
     m = 0
     do k = 1, c%nact
-      if (c%act(k)%lambda > 0) cycle
+      if (c%act(k)%lambda > 0 .and. .not. (keep_stuck .and. beyond_cone(c, c%act(k)))) cycle
       m = m + 1
       c%act(m) = c%act(k)
     end do

@@ -21,7 +21,7 @@ module casca_contact_friction
   use casca_time_scheme, only: scheme_t
   implicit none
   private
-  public :: friction_on, friction_update, friction_hold, friction_step_done, pair_tangential_force
+  public :: friction_on, beyond_cone, friction_update, friction_hold, friction_step_done, pair_tangential_force
 
 contains
 
@@ -31,6 +31,14 @@ contains
     integer, intent(in) :: p
     friction_on = allocated(c%x_start) .and. (c%mu_d(p) > 0 .or. c%mu_s(p) > 0)
   end function friction_on
+
+  !> Whether sticking constraint a's force is outside Coulomb's cone, |f_t| > mu_s |lambda|
+  pure logical function beyond_cone(c, a)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    beyond_cone = .false.
+    if (a%grip == stick) beyond_cone = norm2(a%lt) > c%mu_s(a%pair)*max(-a%lambda, 0._dp)
+  end function beyond_cone
 
   !> Stick/slip changes at the converged iterate; changed: how many.
   subroutine friction_update(c, changed)
@@ -44,7 +52,7 @@ contains
         select case (a%grip)
         case (stick)
           f = a%lt(1)*a%t(:, 1) + a%lt(2)*a%t(:, 2)   ! minus the stick force on the node
-          if (norm2(f) > c%mu_s(a%pair)*max(-a%lambda, 0._dp)) then
+          if (beyond_cone(c, a)) then
             a%grip = slip; a%s = f/norm2(f); a%s0 = a%s; a%lt = 0
             changed = changed + 1; a%flips = a%flips + 1
           end if

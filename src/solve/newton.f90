@@ -13,7 +13,10 @@
 !> max_iter counts the iterations of one active set: a change starts the count again (a hoop's
 !> contact nodes going from stick to slip one batch per convergence took 20 iterations in all,
 !> and the step was cut although each set converged), and the changes are counted apart, at
-!> most max_set_changes.
+!> most max_set_changes. A change is one decision where the set was judged (set_changed), however
+!> many constraints it moves: new penetrations taken between them belong to the iterations of
+!> the set (counted one each, a plate landing flat and turning, its nodes touching a few at a
+!> time and each batch going from stick to slip at once, had its step cut after four decisions).
 !>
 !> With reuse, a factorisation is kept across iterations and steps while each iteration
 !> shrinks the increment fast enough (modified Newton: only the force is assembled then). A
@@ -43,7 +46,7 @@ module casca_newton
   public :: newton_opts_t, newton_report_t, newton_solve
 
   integer, parameter :: max_hist = 100
-  integer, parameter :: max_set_changes = 12   !< active-set changes per step before a cut
+  integer, parameter :: max_set_changes = 12   !< active-set decisions per step before a cut
   integer, parameter :: max_backtracks = 4     !< line-search reductions of one increment
   !> an iterate whose last increment is within this share of the scene size decides the active
   !> set (releases, new penetrations; stick and slip wait for convergence): converging each
@@ -113,6 +116,7 @@ contains
     type(rows_t) :: rows
     type(increment_t) :: inc
     integer :: it, it_set, nc, version
+    integer :: settles   !< the active-set changes decided in this solve (set_changed)
     integer :: set_start   !< the first increment of the current active set
     integer :: follow_start   !< the iteration after which the sliding directions followed the slip
     real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
@@ -132,7 +136,7 @@ contains
     ffloor = 0
     if (present(cm)) ffloor = inertial_floor(model, cm, opts%tol)
     refresh_next = .false.
-    it_set = 0; set_start = 1
+    it_set = 0; set_start = 1; settles = 0
     do it = 1, max_hist
       it_set = it_set + 1
       if (it_set > opts%max_iter) exit
@@ -169,7 +173,7 @@ contains
         if (slip_rule_changed(contact, it, settling(rep, set_start), follow_start)) inc%set = -1
       end if
       if (.not. small_enough(rep, step_tol(opts%tol, q, model%length, qn))) then
-        if (near_enough(rep, set_start, contact)) then
+        if (near_enough(rep, set_start, settles, contact)) then
           if (set_changed(stick=.false.)) call new_set()
           if (allocated(err)) exit
         end if
@@ -209,7 +213,7 @@ contains
       version = 0
       call timer_start(t_contact)
       if (present(contact)) then
-        call contact_update(contact, model, q, contact%changes < max_set_changes, added, &
+        call contact_update(contact, model, q, settles < max_set_changes, added, &
                             reproject=reproject)
         nc = contact_newton_nrows(contact)
         if (present(qn) .and. present(af)) call contact_force_points(contact, model, af, q, qn)
@@ -338,7 +342,8 @@ contains
       call contact_settle(contact, model, q, stick, changed)
       call timer_stop(t_contact)
       set_changed = changed > 0
-      if (set_changed .and. contact%changes >= max_set_changes) &
+      if (set_changed) settles = settles + 1
+      if (set_changed .and. settles >= max_set_changes) &
         call fatal_error(err, 'the contact active set did not settle')
     end function set_changed
 
@@ -459,13 +464,13 @@ contains
   !> the rest wait for convergence, where the multipliers' signs are sure (three tubes in a
   !> pile: 18 and 6 constraints in turn, released and taken again from near iterates, until
   !> the step was cut)
-  logical pure function near_enough(rep, set_start, contact)
+  logical pure function near_enough(rep, set_start, settles, contact)
     type(newton_report_t), intent(in) :: rep
-    integer, intent(in) :: set_start
+    integer, intent(in) :: set_start, settles   !< settles: the changes decided so far
     type(contact_t), intent(in), optional :: contact
     near_enough = .false.
     if (.not. present(contact)) return
-    if (contact%changes >= max_set_changes/2) return
+    if (settles >= max_set_changes/2) return
     near_enough = settling(rep, set_start)
   end function near_enough
 
