@@ -3,7 +3,7 @@ module casca_strings
   use, intrinsic :: iso_fortran_env, only: int32, int64, real64
   implicit none
   private
-  public :: itoa, rtoa, ftoa, count_of, as_word
+  public :: itoa, rtoa, vtoa, ftoa, count_of, as_word
 
   !> n as its shortest decimal text (default and 64-bit integers, e.g. HDF5's hsize_t)
   interface itoa
@@ -34,6 +34,13 @@ contains
     write (b, '(es12.4)') x
     s = trim(adjustl(b))
   end function rtoa
+
+  !> (x, y, z) of a point, each as rtoa
+  pure function vtoa(x) result(s)
+    real(real64), intent(in) :: x(3)
+    character(len=:), allocatable :: s
+    s = '('//rtoa(x(1))//', '//rtoa(x(2))//', '//rtoa(x(3))//')'
+  end function vtoa
 
   !> x with 3 decimals and a leading zero, e.g. 3.780, 0.125, -0.004 (percentages); beyond
   !> 1e15 (or not a number) as rtoa

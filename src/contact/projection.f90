@@ -161,8 +161,8 @@ contains
     type(constraint_t), intent(inout) :: con
     type(normal_cache_t), intent(inout), optional :: normals
     logical, intent(in), optional :: lever
-    real(dp) :: dphi(10, 2), xt(3), xe(3, 10), own(3), m(3), ne(3), gm, gt(3), ft
-    integer :: j, i, nd, bi, bt
+    real(dp) :: dphi(10, 2), xt(3), xe(3, 10), m(3), gm, gt(3), ft
+    integer :: j, nd, bi, bt
     bi = c%pair(1, con%pair); bt = c%pair(2, con%pair)
     con%off = 0; con%wg = 0; con%nl = 0
     if (bt <= 0) then
@@ -180,18 +180,10 @@ contains
     xt = matmul(xe, con%shp)
     if (c%nodal_normal) then
       con%n = 0
-      associate (g => c%geo)
-        do j = 1, 10
-          nd = model%conn(j, con%elem)
-          own = normal_at(con%elem, j)
-          m = 0   ! the normals of the elements at node j, turned to this element's side
-          do i = g%node_start(nd), g%node_start(nd + 1) - 1
-            ne = normal_at(g%node_elem(i), g%node_loc(i))
-            m = m + sign(1._dp, dot_product(ne, own))*ne
-          end do
-          con%n = con%n + (con%shp(j)/norm2(m))*m
-        end do
-      end associate
+      do j = 1, 10
+        call node_normal_sum(c, model, x, con%elem, j, m, normals)
+        con%n = con%n + (con%shp(j)/norm2(m))*m
+      end do
     else
       con%n = unit_normal(xe, dphi)
     end if
@@ -229,21 +221,6 @@ contains
     call hold_force_point(con)
     call friction_geometry()
   contains
-    !> the unit normal of element e at its node k
-    function normal_at(e, k) result(nk)
-      integer, intent(in) :: e, k
-      real(dp) :: nk(3)
-      if (present(normals)) then
-        if (.not. normals%made(k, e)) then
-          normals%n(:, k, e) = unit_normal(x(:, model%conn(:, e)), c%geo%dphi_node(:, :, k))
-          normals%made(k, e) = .true.
-        end if
-        nk = normals%n(:, k, e)
-      else
-        nk = unit_normal(x(:, model%conn(:, e)), c%geo%dphi_node(:, :, k))
-      end if
-    end function normal_at
-
     !> tangents (the first kept from the last, turned across n) and the relative tangential
     !> displacement of the node over the step
     subroutine friction_geometry()
@@ -516,10 +493,10 @@ contains
     type(constraint_t), intent(in) :: con
     integer, intent(out) :: nl, lnode(max_lever)
     real(dp), intent(out) :: lg(3, max_lever)
-    type(normal_cache_t), intent(in), optional :: normals   !< made by constraint_geometry
+    type(normal_cache_t), intent(inout), optional :: normals   !< made by constraint_geometry
     integer, parameter :: max_elem = 64
-    real(dp) :: shp(10), dphi(10, 2), u(3), bu(3), m(3, 10), own(3, 10), bm(3), t(3), ge(3, 10, max_elem)
-    integer :: j, i, nd, l, p, ne, el(max_elem), iv
+    real(dp) :: shp(10), dphi(10, 2), u(3), bu(3), m(3, 10), bm(3), t(3), ge(3, 10, max_elem)
+    integer :: j, i, nd, l, p, ne, el(max_elem), iv, nv
     real(dp) :: sg(10*max_elem)   ! (each visit's sign, the forward's for the backward)
     nl = 0; ne = 0; iv = 0
     call tri10_shape(con%xi(1), con%xi(2), shp, dphi)
@@ -530,18 +507,14 @@ contains
         u = 0
         do j = 1, 10   ! (forward, as constraint_geometry)
           nd = model%conn(j, con%elem)
-          own(:, j) = unit_at(con%elem, j)
-          m(:, j) = 0
-          do i = g%node_start(nd), g%node_start(nd + 1) - 1
-            t = unit_at(g%node_elem(i), g%node_loc(i))
-            iv = min(iv + 1, size(sg)); sg(iv) = sign(1._dp, dot_product(t, own(:, j)))
-            m(:, j) = m(:, j) + sg(iv)*t
-          end do
+          nv = g%node_start(nd + 1) - g%node_start(nd)
+          if (iv + nv > size(sg)) return
+          call node_normal_sum(c, model, x, con%elem, j, m(:, j), normals, sg(iv + 1:iv + nv))
+          iv = iv + nv
           u = u + (shp(j)/norm2(m(:, j)))*m(:, j)
         end do
         bu = u/norm2(u)
         bu = con%side*(dv - dot_product(dv, bu)*bu)/norm2(u)
-        if (iv == size(sg)) return
         iv = 0
         do j = 1, 10
           nd = model%conn(j, con%elem)
@@ -569,18 +542,6 @@ contains
       end do
     end do
   contains
-    !> the unit normal of element e at its node k (the cache's, where it was made)
-    function unit_at(e, k) result(tn)
-      integer, intent(in) :: e, k
-      real(dp) :: tn(3)
-      if (present(normals)) then
-        if (normals%made(k, e)) then
-          tn = normals%n(:, k, e); return
-        end if
-      end if
-      tn = unit_normal(x(:, model%conn(:, e)), c%geo%dphi_node(:, :, k))
-    end function unit_at
-
     !> add the gradient of b . s t/|t| (t element e's cubic normal where its shape
     !> derivatives are ds) on e's nodes
     subroutine back_normal(e, ds, b, s)
@@ -604,6 +565,50 @@ contains
       end do
     end subroutine back_normal
   end subroutine normal_lever
+
+  !> The unit normal of element e at its node k at positions x (normals: the cache, filled
+  !> here where it was not made)
+  function element_normal(c, model, x, e, k, normals) result(nk)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: x(:, :)
+    integer, intent(in) :: e, k
+    type(normal_cache_t), intent(inout), optional :: normals
+    real(dp) :: nk(3)
+    if (present(normals)) then
+      if (.not. normals%made(k, e)) then
+        normals%n(:, k, e) = unit_normal(x(:, model%conn(:, e)), c%geo%dphi_node(:, :, k))
+        normals%made(k, e) = .true.
+      end if
+      nk = normals%n(:, k, e)
+    else
+      nk = unit_normal(x(:, model%conn(:, e)), c%geo%dphi_node(:, :, k))
+    end if
+  end function element_normal
+
+  !> m: the sum of the unit normals, at element e's node k, of every element there, each
+  !> turned to e's side (the nodal normal's direction); sg: their signs, in that order
+  !> (normal_lever's backward pass takes the same)
+  subroutine node_normal_sum(c, model, x, e, k, m, normals, sg)
+    type(contact_t), intent(in) :: c
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: x(:, :)
+    integer, intent(in) :: e, k
+    real(dp), intent(out) :: m(3)
+    type(normal_cache_t), intent(inout), optional :: normals
+    real(dp), intent(out), optional :: sg(:)
+    real(dp) :: own(3), t(3), s
+    integer :: i, nd
+    nd = model%conn(k, e)
+    own = element_normal(c, model, x, e, k, normals)
+    m = 0
+    do i = c%geo%node_start(nd), c%geo%node_start(nd + 1) - 1
+      t = element_normal(c, model, x, c%geo%node_elem(i), c%geo%node_loc(i), normals)
+      s = sign(1._dp, dot_product(t, own))
+      m = m + s*t
+      if (present(sg)) sg(i - c%geo%node_start(nd) + 1) = s
+    end do
+  end subroutine node_normal_sum
 
   !> The force acts at the gap's point until force_point finds its own
   pure subroutine hold_force_point(con)

@@ -74,12 +74,8 @@ contains
           xf = positions(model, qf)
           if (c%nodal_normal) call normal_cache(model, normals)
         end if
-        cf = c%act(k)
-        if (c%nodal_normal) then
-          call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
-        else
-          call constraint_geometry(c, model, xf, qf, cf, lever=.true.)
-        end if
+        cf = c%act(k)   ! (normals: made and read with nodal normals only)
+        call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
         if (cf%nl /= c%act(k)%nl) cycle   ! (the same nodes; else the end's gradient)
         c%act(k)%nf = cf%n; c%act(k)%wgf = cf%wg; c%act(k)%lgradf = cf%lgrad
         cycle

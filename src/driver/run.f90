@@ -36,7 +36,7 @@ module casca_run
   use casca_files, only: folder_of
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
-  use casca_strings, only: count_of, rtoa, ftoa, itoa
+  use casca_strings, only: count_of, rtoa, vtoa, ftoa, itoa
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   implicit none
   private
@@ -46,6 +46,9 @@ module casca_run
   !> with an error-controlled step: the energy's cap (run_t%dt_cap) doubles after this many of
   !> its lengths
   real(dp), parameter :: cap_hold = 20
+  !> Saint-Venant-Kirchhoff's least thickness stretch: its uniaxial compressive stress,
+  !> E lambda (lambda^2 - 1)/2, is largest at lambda = 1/sqrt(3) (squeezed)
+  real(dp), parameter :: svk_limit = 1/sqrt(3._dp)
 
   type :: progress_t   !< where the last progress line was
     real(dp) :: wall = 0, t = 0
@@ -1000,13 +1003,12 @@ contains
     end if
   end subroutine watch_thickness
 
-  !> A shell squeezed through its thickness past Saint-Venant-Kirchhoff's limit: in uniaxial
-  !> compression its stress, E lambda (lambda^2 - 1)/2, is largest at lambda = 1/sqrt(3) and
-  !> falls as it is squeezed further, so the equations lose their solution there (a rubber
+  !> A shell squeezed through its thickness past Saint-Venant-Kirchhoff's limit (svk_limit):
+  !> squeezed further its stress falls, so the equations lose their solution there (a rubber
   !> ring thrown at a floor at 15 m/s reached 0.2 and Newton stalled)
   logical function squeezed(r)
     type(run_t), intent(in) :: r
-    squeezed = r%squeeze < 1/sqrt(3._dp)
+    squeezed = r%squeeze < svk_limit
   end function squeezed
 
   function squeeze_note(r) result(msg)
@@ -1017,10 +1019,10 @@ contains
     n = r%squeeze_node; b = r%model%node_body(n)
     how = 'squeezed through its thickness to '//itoa(nint(100*r%squeeze))//'%'
     if (r%squeeze <= 0) how = 'turned inside out through its thickness'
-    msg = 'body '''//r%model%body(b)%name//''' was '//how//' at its node '//itoa(n - r%model%body(b)%node_first + 1)// &
-          ' (at '//trim(rtoa(r%model%x0(1, n)))//', '//trim(rtoa(r%model%x0(2, n)))//', '// &
-          trim(rtoa(r%model%x0(3, n)))//' at the start) at t = '//trim(rtoa(r%t_squeeze))// &
-          ' s; the Saint-Venant-Kirchhoff material holds to 58% only (squeezed further, its '// &
+    msg = 'body '''//r%model%body(b)%name//''' was '//how//' at its node '// &
+          itoa(n - r%model%body(b)%node_first + 1)//' (at '//vtoa(r%model%x0(:, n))// &
+          ' at the start) at t = '//rtoa(r%t_squeeze)//' s; the Saint-Venant-Kirchhoff '// &
+          'material holds to '//itoa(nint(100*svk_limit))//'% only (squeezed further, its '// &
           'stress falls): the results there are beyond the material law (a slower impact, or a '// &
           'thicker or stiffer shell, stays within it)'
   end function squeeze_note

@@ -16,7 +16,7 @@ module casca_scene
   use casca_obstacle, only: obstacle_t
   use casca_contact, only: contact_t, contact_init, contact_set_stiffness
   use casca_orientation, only: reverse_elements, edge_census_t, edge_census
-  use casca_strings, only: itoa, rtoa
+  use casca_strings, only: itoa, rtoa, vtoa
   implicit none
   private
   public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles, &
@@ -425,9 +425,8 @@ contains
           end associate
         end do
         if (best > max(0.05_dp*size_b, edge)) far = [character(len=300) :: far, '&output track '// &
-          itoa(k)//': the nearest node of '''//b%name//''' is '//rtoa(best)//' m from ('// &
-          rtoa(deck%output%track(1, k))//', '//rtoa(deck%output%track(2, k))//', '// &
-          rtoa(deck%output%track(3, k))//'), '//itoa(nint(100*best/size_b))//'% of the '// &
+          itoa(k)//': the nearest node of '''//b%name//''' is '//rtoa(best)//' m from '// &
+          vtoa(deck%output%track(:, k))//', '//itoa(nint(100*best/size_b))//'% of the '// &
           'body''s size: track points are in the scene''s coordinates (after center and rotate)']
       end associate
     end do

@@ -28,7 +28,7 @@ module casca_starter
   use casca_model, only: model_t, dof, element_dofs, area_points, element_area
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
-  use casca_strings, only: itoa, rtoa, count_of
+  use casca_strings, only: itoa, rtoa, vtoa, count_of
   use casca_scene, only: scene_contact, initial_state, tracked_nodes, area_per_node, clearly
   use casca_newmark, only: state_t
   use casca_contact, only: contact_t, search_radius, tested_both_ways
@@ -208,7 +208,7 @@ contains
       write (u, '(a)') '  body '''//bd%name//''': '//count_of(f%nodes, 'node', 'nodes')//', '// &
         count_of(f%elements, 'element', 'elements')//', thickness '//rtoa(bd%thickness)// &
         ' m, area '//rtoa(f%area)//' m^2, mass '//trim(adjustl(mass))//' kg'
-      write (u, '(a)') '    box '//vec(f%lo)//' to '//vec(f%hi)//' m, size '// &
+      write (u, '(a)') '    box '//vtoa(f%lo)//' to '//vtoa(f%hi)//' m, size '// &
         rtoa(f%hi(1) - f%lo(1))//' x '//rtoa(f%hi(2) - f%lo(2))//' x '//rtoa(f%hi(3) - f%lo(3))// &
         ' m; mesh '//shape
       write (u, '(a)') '    l_min '//rtoa(f%l_min)//' m, quality '//rtoa(f%quality)// &
@@ -421,11 +421,4 @@ contains
     character(len=*), intent(in) :: text
     w = [character(len=len(w)) :: w, text]
   end subroutine add
-
-  !> (x, y, z) of a point
-  pure function vec(x) result(s)
-    real(dp), intent(in) :: x(3)
-    character(len=:), allocatable :: s
-    s = '('//rtoa(x(1))//', '//rtoa(x(2))//', '//rtoa(x(3))//')'
-  end function vec
 end module casca_starter

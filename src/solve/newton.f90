@@ -169,9 +169,8 @@ contains
       call take_increment()
       if (allocated(err)) exit
       if (refresh_next) cycle   ! (the increment was undone)
-      if (present(contact)) then   ! (a new rule: the residual's change is not the increment's)
-        if (slip_rule_changed(contact, it, settling(rep, set_start), follow_start)) inc%set = -1
-      end if
+      ! (a new rule for the sliding directions: the residual's change is not the increment's)
+      if (slip_rule_changed(it, settling(rep, set_start), follow_start, contact)) inc%set = -1
       if (.not. small_enough(rep, step_tol(opts%tol, q, model%length, qn))) then
         if (near_enough(rep, set_start, settles, contact)) then
           if (set_changed(stick=.false.)) call new_set()
@@ -180,10 +179,8 @@ contains
         cycle
       end if
       if (residual_estimate() > max(opts%force_tol*fref, ffloor)) cycle
-      if (present(contact)) then
-        if (slip_held(contact, it, follow_start)) then
-          inc%set = -1; cycle
-        end if
+      if (slip_held(it, follow_start, contact)) then
+        inc%set = -1; cycle
       end if
       if (set_changed(stick=.true.)) then
         if (allocated(err)) exit
@@ -362,12 +359,13 @@ contains
   !> cycled (a ball sliding inside a shell). follow_iters iterations after that without
   !> convergence, they are held at the solve's start for the rest of it (friction_hold).
   !> True when the rule changed at this iterate it.
-  logical function slip_rule_changed(contact, it, near, follow_start) result(changed)
-    type(contact_t), intent(inout) :: contact
+  logical function slip_rule_changed(it, near, follow_start, contact) result(changed)
     integer, intent(in) :: it
     logical, intent(in) :: near
     integer, intent(inout) :: follow_start   !< the iterate after which they followed
+    type(contact_t), intent(inout), optional :: contact
     changed = .false.
+    if (.not. present(contact)) return
     if (contact%hold_slip) return
     if (contact%follow_slip) then
       if (it - follow_start >= follow_iters) then
@@ -380,11 +378,12 @@ contains
 
   !> Converged with the sliding directions held (a set that converged before it was near):
   !> they follow the slip from here, and Newton goes on
-  logical function slip_held(contact, it, follow_start)
-    type(contact_t), intent(inout) :: contact
+  logical function slip_held(it, follow_start, contact)
     integer, intent(in) :: it
     integer, intent(inout) :: follow_start
+    type(contact_t), intent(inout), optional :: contact
     slip_held = .false.
+    if (.not. present(contact)) return
     if (contact%follow_slip .or. contact%hold_slip) return
     if (.not. any(contact%act(1:contact%nact)%grip == slip)) return
     contact%follow_slip = .true.; follow_start = it
