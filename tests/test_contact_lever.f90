@@ -10,13 +10,17 @@
 !> row, checked here with its lever left out, nl = 0). The force row has no net force and
 !> no moment about the origin at the midpoint (positions and fibres), to 1e-10 of the
 !> row's size. Nodal normals (the default) and element normals.
+!> Second scene: a plate (h 10 mm, 4 x 4 cells, tilted 30 degrees) pressed 2 mm into the
+!> top edge of a band standing on its rim (one pass: the plate's nodes are the impactor),
+!> so that its nodes meet the band's rounded edge (around_rim): the same checks, the row
+!> without its lever off by more than 0.1.
 program test_contact_lever
   use casca_kinds, only: dp
   use casca_error, only: error_t
   use casca_mesh, only: mesh_t
   use casca_mesh_generators, only: mesh_plate
   use casca_model, only: model_t, model_add_body, model_finalize, reference_state, dof
-  use casca_contact, only: contact_t, constraint_t, contact_init
+  use casca_contact, only: contact_t, constraint_t, contact_init, around_rim
   use casca_contact_active_set, only: contact_update
   use casca_contact_projection, only: positions, constraint_geometry, constraint_row, max_row
   use casca_contact_rows, only: contact_force_points
@@ -31,6 +35,8 @@ program test_contact_lever
   call scene(model, q, qn)
   call check_rows(.true., 'nodal normals')
   call check_rows(.false., 'element normals')
+  call rim_scene(model, q, qn)
+  call check_rows(.true., 'rim')
   call check_summary()
 
 contains
@@ -41,8 +47,8 @@ contains
     real(dp), allocatable, intent(out) :: q(:), qn(:)
     type(mesh_t) :: blade, plate
     type(error_t), allocatable :: err
-    real(dp) :: a, r(3, 3), z0, p(6)
-    integer :: n, i, nseed
+    real(dp) :: a, r(3, 3), z0
+    integer :: i, nseed
     integer, allocatable :: seed(:)
     call random_seed(size=nseed)
     seed = [(7919*i + 13, i=1, nseed)]
@@ -61,6 +67,43 @@ contains
     plate%x(3, :) = 0.004_dp*sin(20*plate%x(1, :) + 0.3_dp)*cos(15*plate%x(2, :) + 0.2_dp)
     call model_add_body(model, 'blade', blade, 210e9_dp, 0.3_dp, 7800._dp, 0.01_dp)
     call model_add_body(model, 'plate', plate, 210e9_dp, 0.3_dp, 7800._dp, 0.01_dp)
+    call perturbed(model, q, qn)
+  end subroutine scene
+
+  !> a plate tilted 30 degrees about x, 2 mm into the rounded top edge (y = 0, z = 0) of a
+  !> band standing in the x-z plane
+  subroutine rim_scene(model, q, qn)
+    type(model_t), intent(out) :: model
+    real(dp), allocatable, intent(out) :: q(:), qn(:)
+    type(mesh_t) :: plate, band
+    type(error_t), allocatable :: err
+    real(dp) :: a, r(3, 3)
+    call mesh_plate(0.1_dp, 0.1_dp, 4, 4, plate, err)
+    if (allocated(err)) error stop 'mesh'
+    a = 30*acos(-1._dp)/180
+    r = reshape([1._dp, 0._dp, 0._dp, 0._dp, cos(a), sin(a), 0._dp, -sin(a), cos(a)], [3, 3])
+    plate%x(1:2, :) = plate%x(1:2, :) - 0.05_dp
+    plate%x = matmul(r, plate%x); plate%normal = matmul(r, plate%normal)
+    plate%x(1, :) = plate%x(1, :) + 0.013_dp; plate%x(2, :) = plate%x(2, :) + 0.002_dp
+    plate%x(3, :) = plate%x(3, :) + 0.003_dp
+    call mesh_plate(0.3_dp, 0.1_dp, 6, 2, band, err)
+    if (allocated(err)) error stop 'mesh'
+    a = acos(-1._dp)/2
+    r = reshape([1._dp, 0._dp, 0._dp, 0._dp, cos(a), sin(a), 0._dp, -sin(a), cos(a)], [3, 3])
+    band%x(1, :) = band%x(1, :) - 0.15_dp; band%x(2, :) = band%x(2, :) - 0.1_dp
+    band%x = matmul(r, band%x); band%normal = matmul(r, band%normal)
+    call model_add_body(model, 'plate', plate, 210e9_dp, 0.3_dp, 7800._dp, 0.01_dp)
+    call model_add_body(model, 'band', band, 210e9_dp, 0.3_dp, 7800._dp, 0.01_dp)
+    call perturbed(model, q, qn)
+  end subroutine rim_scene
+
+  !> the reference state perturbed at random (q), and another state near it (qn)
+  subroutine perturbed(model, q, qn)
+    type(model_t), intent(inout) :: model
+    real(dp), allocatable, intent(out) :: q(:), qn(:)
+    type(error_t), allocatable :: err
+    real(dp) :: p(6)
+    integer :: n
     call model_finalize(model, err)
     if (allocated(err)) error stop 'model'
     allocate (q(model%ndof))
@@ -76,7 +119,7 @@ contains
       qn(dof(n, 1):dof(n, 3)) = qn(dof(n, 1):dof(n, 3)) + 2e-4_dp*(p(1:3) - 0.5_dp)
       qn(dof(n, 4):dof(n, 6)) = qn(dof(n, 4):dof(n, 6)) + 0.02_dp*(p(4:6) - 0.5_dp)
     end do
-  end subroutine scene
+  end subroutine perturbed
 
   subroutine check_rows(nodal, label)
     logical, intent(in) :: nodal
@@ -90,6 +133,9 @@ contains
     c%nodal_normal = nodal
     call contact_update(c, model, q, .true., added)
     call check_true(label//': constraints made ('//itoa(c%nact)//')', c%nact >= 4)
+    if (label == 'rim') call check_true(label//': constraints around the rim ('// &
+                                        itoa(count(c%act(1:c%nact)%side == around_rim))//')', &
+                                        count(c%act(1:c%nact)%side == around_rim) >= 4)
     ! the gap's rows at q
     e_gap = 0; e_old = 0; maxlever = 0
     do k = 1, c%nact

@@ -4,7 +4,8 @@ module casca_contact_active_set
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
-  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds, new_constraint
+  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds, new_constraint, &
+                           around_rim
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry, normal_cache_t, &
                                       normal_cache
   use casca_contact_friction, only: friction_on, beyond_cone, friction_update
@@ -46,19 +47,17 @@ contains
           call constraint_geometry(c, model, x, q, c%act(k), normals, lever=.true.); cycle
         end if
       end if
-      if (c%pair(2, c%act(k)%pair) > 0 .and. c%act(k)%elem > 0) then
+      if (c%pair(2, c%act(k)%pair) > 0) then
         call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
         if (found) then
           c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd
+          if ((cn%side == around_rim) .neqv. (c%act(k)%side == around_rim)) then   ! (onto or off a rim)
+            c%act(k)%side = cn%side; c%act(k)%face(2) = 0
+          end if
+        else if (c%act(k)%elem == 0) then   ! restored from a checkpoint, nothing to press on
+          c%act(k)%lambda = 1   ! (released at the next release)
+          cycle
         end if   ! (else far from every sub-triangle within reach: keep the last point)
-      else if (c%pair(2, c%act(k)%pair) > 0) then   ! restored from a checkpoint
-        call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
-        if (found) then
-          c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd
-        else
-          c%act(k)%lambda = 1   ! nothing to press on: released at the next release
-          c%act(k)%elem = 0; cycle
-        end if
       end if
       call constraint_geometry(c, model, x, q, c%act(k), normals, lever=.true.)
     end do

@@ -25,10 +25,14 @@ module casca_contact
   !> about 70 on a mesh of valence 6); a constraint with more leaves its lever out
   integer, parameter, public :: max_lever = 100
 
+  integer, parameter, public :: around_rim = 2   !< constraint_t%side of a node at a rim
+
   type :: constraint_t
     integer :: node = 0, pair = 0
     integer :: elem = 0         !< target element; 0: an obstacle, or not projected yet (restart)
-    integer :: side = 0         !< side of a two-sided target the node is on (+-1), 0: not known
+    !> side of a two-sided target the node is on (+-1), 0: not known; around_rim: beside an
+    !> open surface's rim, whose edge the node meets (projection.f90, rim_normal)
+    integer :: side = 0
     real(dp) :: xi(2) = 0, n(3) = 0, shp(10) = 0
     !> where the force acts on the target (projection.f90, force_point): its face's point on
     !> the node's line along n at the configuration the internal force is taken at; the rows

@@ -13,7 +13,7 @@ module casca_checkpoint
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t
   use casca_newmark, only: state_t
-  use casca_contact, only: contact_t, new_constraint
+  use casca_contact, only: contact_t, new_constraint, around_rim
   use casca_contact_projection, only: positions, constraint_geometry
   use casca_hdf5_io, only: write_checkpoint, read_checkpoint
   use casca_mpi, only: is_root
@@ -223,9 +223,9 @@ contains
         associate (e => ints(5 + per*(k - 1)), sd => ints(6 + per*(k - 1)), &
                    f => ints(7 + per*(k - 1):8 + per*(k - 1)), bt => contact%pair(2, pair), &
                    grip => ints(9 + per*(k - 1)))
-          if (abs(sd) > 1 .or. any(f < -1) .or. any(f > 2) .or. grip < 0 .or. grip > 2) then
+          if ((abs(sd) > 1 .and. sd /= around_rim) .or. any(f < -1) .or. any(f > 2) .or. grip < 0 .or. grip > 2) then
             bad = 'contact '//itoa(k)//' has side '//itoa(sd)//', faces '//itoa(f(1))//', '// &
-                  itoa(f(2))//' or grip '//itoa(grip)//' out of range (side -1, 0, 1; face -1, 0, '// &
+                  itoa(f(2))//' or grip '//itoa(grip)//' out of range (side -1, 0, 1, '//itoa(around_rim)//'; face -1, 0, '// &
                   '1, 2; grip 0, 1, 2)'
           else if (e /= 0 .and. bt <= 0) then
             bad = 'contact '//itoa(k)//' names element '//itoa(e)//' on an obstacle'
