@@ -13,11 +13,13 @@
 !>   q'' = 6 t (q = t^3) from exact data at t = 1 (the algorithmic acceleration of
 !>   generalized-alpha: 6 (t + (alpha_m - alpha_f) dt)), dt = 1e-3: ratio 1 within 1% for the
 !>   trapezoidal rule and generalized-alpha (the Zienkiewicz & Xie estimate is exact for a
-!>   linear acceleration).
+!>   linear acceleration);
+!> - uses_acceleration: one step of q'' + q = 0 from a = 0 and from a = 100 gives the same q1
+!>   (to 1e-12) at rho_inf 1 (the midpoint rule) only, and there the predictor is q + dt v.
 program test_time_scheme
   use casca_kinds, only: dp
   use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
-  use casca_check, only: check_close, check_le, check_summary
+  use casca_check, only: check_close, check_le, check_true, check_summary
   implicit none
   type(scheme_t) :: s
   real(dp) :: rho(4) = [0._dp, 0.5_dp, 0.8_dp, 1._dp], e1, e2
@@ -53,6 +55,11 @@ program test_time_scheme
   call estimate_check('error estimate / true local error, trapezoidal', newmark_scheme(0.25_dp, 0.5_dp))
   call estimate_check('error estimate / true local error, rho_inf 0.8', alpha_scheme(0.8_dp))
   call estimate_check('error estimate / true local error, rho_inf 0.5', alpha_scheme(0.5_dp))
+
+  call acceleration_check('rho_inf 1', alpha_scheme(1._dp), .false.)
+  call acceleration_check('rho_inf 0.8', alpha_scheme(0.8_dp), .true.)
+  call acceleration_check('trapezoidal rule', newmark_scheme(0.25_dp, 0.5_dp), .true.)
+  call acceleration_check('thesis Newmark', newmark_scheme(1._dp, 1.5_dp), .true.)
   call check_summary()
 
 contains
@@ -129,4 +136,23 @@ contains
     call check_close(label, s%error_coefficient()*s%dt**2*(x(3) - a0)/(x(1) - (t + s%dt)**3), &
                      1._dp, 1e-2_dp)
   end subroutine estimate_check
+
+  !> uses_acceleration against the step itself: whether one step's q1 changes with the start
+  !> acceleration; a scheme whose step does not use it predicts q + dt v
+  subroutine acceleration_check(label, s0, uses)
+    character(len=*), intent(in) :: label
+    type(scheme_t), intent(in) :: s0
+    logical, intent(in) :: uses
+    type(scheme_t) :: s
+    real(dp) :: x(3), y(3), qp(1)
+    s = s0; s%dt = 0.1_dp
+    x = [1._dp, 0.5_dp, 0._dp]; y = [1._dp, 0.5_dp, 100._dp]
+    call step(s, 1._dp, 0._dp, x)
+    call step(s, 1._dp, 0._dp, y)
+    call check_true(label//': the step depends on the start acceleration, as uses_acceleration says', &
+                    ((abs(x(1) - y(1)) > 1e-12_dp) .eqv. uses) .and. (s%uses_acceleration() .eqv. uses))
+    if (uses) return
+    call s%predictor([1._dp], [0.5_dp], [100._dp], qp)
+    call check_close(label//': predictor q + dt v', qp(1), 1.05_dp, 1e-15_dp)
+  end subroutine acceleration_check
 end program test_time_scheme
