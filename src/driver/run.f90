@@ -1073,8 +1073,8 @@ contains
     why = 'a node that came deep into a target in one step'
     if (allocated(r%contact)) then   ! (closed shells have no rim)
       if (any(r%contact%rim)) why = 'a shell''s edge that passed between the other''s nodes (casca has '// &
-                                    'no edge-to-edge contact: test the edge''s body as impactor, or '// &
-                                    'passes = 2), or a node that came deep into a target in one step'
+                                    'no edge-to-edge contact; with one pass, test the edge''s body as impactor or '// &
+                                    'set passes = 2), or a node that came deep into a target in one step'
     end if
     ! (under a tolerance the steps in contact are the error estimate's, which leaves the
     ! contact nodes out: two balls head-on made 0.24% in a 100 us step at 1e-3)
