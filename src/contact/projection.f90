@@ -40,6 +40,9 @@ module casca_contact_projection
 
   integer, parameter, public :: max_row = 66 + 3*max_lever   !< 11 nodes x (Y, G), the lever's nodes
   integer, parameter, public :: across = 4     !< the row kind across the slip (row_factors)
+  !> how far outside its element (least area coordinate) a force point is still kept: the
+  !> polynomial face holds just beyond the edge, its weights still summing to one
+  real(dp), parameter :: beyond_element = -0.25_dp
 
 contains
 
@@ -484,7 +487,7 @@ contains
     end do
     ! around a rim the node's line meets the face's polynomial beyond the edge, far out as
     ! n turns across the face: a point more than a sliver outside is the edge's instead
-    out = -0.25_dp
+    out = beyond_element
     if (con%side == around_rim) out = -0.02_dp
     p = q(dof(con%node, 1):dof(con%node, 3)) + con%wg(1)*q(dof(con%node, 4):dof(con%node, 6))
     xi = con%xi
@@ -499,11 +502,11 @@ contains
       dx(1) = dot_product(f, cross(j(:, 2), j(:, 3)))/det
       dx(2) = dot_product(j(:, 1), cross(f, j(:, 3)))/det
       xi = xi + dx
-      if (min(xi(1), xi(2), 1 - xi(1) - xi(2)) < out) exit
+      if (minval(area_coordinates(xi)) < out) exit
       if (maxval(abs(dx)) <= 1e-14_dp) exit
     end do
-    if (maxval(abs(dx)) > 1e-12_dp .or. min(xi(1), xi(2), 1 - xi(1) - xi(2)) < out) then
-      if (con%side == around_rim) call rim_force_point(model, q, con)
+    if (maxval(abs(dx)) > 1e-12_dp .or. minval(area_coordinates(xi)) < out) then
+      if (con%side == around_rim) call rim_force_point(ye, q(dof(con%node, 1):dof(con%node, 3)), con)
       return
     end if
     call tri10_shape(xi(1), xi(2), shp, dphi)
@@ -652,7 +655,7 @@ contains
     real(dp), intent(out), optional :: dxi(2)   !< the edge's direction in xi (tw = dphi dxi)
     real(dp), parameter :: on_edge = 1e-9_dp
     real(dp) :: l(3), d(2)
-    l = [xi(1), xi(2), 1 - xi(1) - xi(2)]
+    l = area_coordinates(xi)
     d = 0
     if (count(l < on_edge) == 1) then
       if (l(1) < on_edge) d = [0._dp, 1._dp]
@@ -678,23 +681,20 @@ contains
   !> on one line but for the node's face offset across n (none where its fibre is along n
   !> or, at its own rim, faded out), as the velocity correction's rows need: held at the
   !> gap's point, two rings meeting rim on rim lost 4e-7 of their angular momentum.
-  pure subroutine rim_force_point(model, q, con)
-    type(model_t), intent(in) :: model
-    real(dp), intent(in) :: q(:)
+  pure subroutine rim_force_point(xe, y, con)
+    real(dp), intent(in) :: xe(3, 10)   !< the target element's mid-surface points
+    real(dp), intent(in) :: y(3)        !< the node's
     type(constraint_t), intent(inout) :: con
-    real(dp) :: xe(3, 10), xi(2), shp(10), dphi(10, 2), n(3), te(3), tw(10), tl, dxi(2), r(3)
-    integer :: k, it
-    do k = 1, 10
-      xe(:, k) = q(dof(model%conn(k, con%elem), 1):dof(model%conn(k, con%elem), 3))
-    end do
+    real(dp) :: xi(2), shp(10), dphi(10, 2), n(3), te(3), tw(10), tl, dxi(2), r(3)
+    integer :: it
     xi = con%xi
     do it = 1, 4
       call tri10_shape(xi(1), xi(2), shp, dphi)
-      r = q(dof(con%node, 1):dof(con%node, 3)) - matmul(xe, shp)
+      r = y - matmul(xe, shp)
       call rim_normal(xe, dphi, xi, r, n, te, tw, tl, dxi)
       if (.not. tl > 0) return
       xi = xi + (dot_product(te, r)/tl)*dxi
-      if (min(xi(1), xi(2), 1 - xi(1) - xi(2)) < -0.25_dp) return
+      if (minval(area_coordinates(xi)) < beyond_element) return
     end do
     call tri10_shape(xi(1), xi(2), shp, dphi)
     con%xif = xi; con%shpf = shp
@@ -726,6 +726,13 @@ contains
       con%lgrad(:, 1 + j) = -con%shp(j)*u - tw(j)*b
     end do
   end subroutine rim_lever
+
+  !> The area coordinates of parent point xi (each is 0 on one edge of the element)
+  pure function area_coordinates(xi) result(l)
+    real(dp), intent(in) :: xi(2)
+    real(dp) :: l(3)
+    l = [xi(1), xi(2), 1 - xi(1) - xi(2)]
+  end function area_coordinates
 
   !> The force acts at the gap's point until force_point finds its own
   pure subroutine hold_force_point(con)
