@@ -169,7 +169,8 @@ contains
     type(normal_cache_t), intent(inout), optional :: normals
     logical, intent(in), optional :: lever
     real(dp) :: dphi(10, 2), xt(3), xe(3, 10), m(3), gm, gt(3), ft, te(3), tw(10), tl
-    integer :: j, nd, bi, bt
+    real(dp) :: lg(3, max_lever)
+    integer :: j, nd, bi, bt, nlv, ln(max_lever)
     logical :: rim
     bi = c%pair(1, con%pair); bt = c%pair(2, con%pair)
     con%off = 0; con%wg = 0; con%nl = 0
@@ -239,7 +240,8 @@ contains
         else if (lever) then
           call normal_lever(c, model, x, con, x(:, con%node) - xt + &
                             con%wg(1)*q(dof(con%node, 4):dof(con%node, 6)) + con%wg(2)*gt, &
-                            con%nl, con%lnode, con%lgrad, normals)
+                            nlv, ln, lg, normals)
+          call set_lever(con, ln(1:nlv), lg(:, 1:nlv))
         end if
       end if
     end if
@@ -710,8 +712,8 @@ contains
     type(model_t), intent(in) :: model
     type(constraint_t), intent(inout) :: con
     real(dp), intent(in) :: r(3), f(3), te(3), tw(10), tl
-    real(dp) :: gm, u(3), b(3)
-    integer :: j
+    real(dp) :: gm, u(3), b(3), lg(3, 11)
+    integer :: j, ln(11)
     con%nl = 0
     gm = dot_product(con%n, r)
     if (.not. gm > 0) return
@@ -719,13 +721,22 @@ contains
     u = u - dot_product(u, te)*te
     b = 0
     if (tl > 0) b = (dot_product(f, te)*con%n + dot_product(te, r)*(con%n + u))/tl
-    con%nl = 11
-    con%lnode(1) = con%node; con%lgrad(:, 1) = u
+    ln(1) = con%node; lg(:, 1) = u
     do j = 1, 10
-      con%lnode(1 + j) = model%conn(j, con%elem)
-      con%lgrad(:, 1 + j) = -con%shp(j)*u - tw(j)*b
+      ln(1 + j) = model%conn(j, con%elem)
+      lg(:, 1 + j) = -con%shp(j)*u - tw(j)*b
     end do
+    call set_lever(con, ln, lg)
   end subroutine rim_lever
+
+  !> The lever of con: the nodes ln its normal depends on and the gap's gradient lg on them
+  pure subroutine set_lever(con, ln, lg)
+    type(constraint_t), intent(inout) :: con
+    integer, intent(in) :: ln(:)
+    real(dp), intent(in) :: lg(:, :)
+    con%nl = size(ln)
+    con%lnode = ln; con%lgrad = lg   ! (reallocated only when nl changes)
+  end subroutine set_lever
 
   !> The area coordinates of parent point xi (each is 0 on one edge of the element)
   pure function area_coordinates(xi) result(l)
@@ -738,7 +749,8 @@ contains
   pure subroutine hold_force_point(con)
     type(constraint_t), intent(inout) :: con
     con%xif = con%xi; con%shpf = con%shp; con%nf = con%n
-    con%wgf = con%wg; con%lgradf(:, 1:con%nl) = con%lgrad(:, 1:con%nl)
+    con%wgf = con%wg
+    if (con%nl > 0) con%lgradf = con%lgrad(:, 1:con%nl)
   end subroutine hold_force_point
 
   !> Unit normal of the cubic surface with node positions xe where the shape derivatives are dphi

@@ -77,7 +77,7 @@ contains
         cf = c%act(k)   ! (normals: made and read with nodal normals only)
         call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
         if (cf%nl /= c%act(k)%nl) cycle   ! (the same nodes; else the end's gradient)
-        c%act(k)%nf = cf%n; c%act(k)%wgf = cf%wg; c%act(k)%lgradf = cf%lgrad
+        c%act(k)%nf = cf%n; c%act(k)%wgf = cf%wg; c%act(k)%lgradf = cf%lgrad(:, 1:cf%nl)
         cycle
       end if
       ! an obstacle: its normal at the node's face point there (the midpoint rule's

@@ -172,9 +172,9 @@ contains
         tre = e(1, 1) + e(2, 2) + e(3, 3)
         sm = 2*mu*e
         sm(1, 1) = sm(1, 1) + lam*tre; sm(2, 2) = sm(2, 2) + lam*tre; sm(3, 3) = sm(3, 3) + lam*tre
-        pm = matmul(am, sm)
         energy = energy + 0.5_dp*c*sum(sm*e)
         if (.not. force) cycle
+        pm = matmul(am, sm)
 
         ! f_p = c P : (A0^-T dA1/dq_p): each dA1/dq_p is a combination of the shape
         ! functions' values times e_k (x) b(k, :), so the point adds three vectors pbk to
