@@ -22,6 +22,12 @@ obstacles      a ring (R 0.2, h 0.04) at (1, -2, 0) m/s above a floor plane 0.3 
                it), closing speed 3 c m/s, time gap / (3 c); the same sphere at rest: 'never'
                (the ring moves away from it).
 self-contact   the ring's pair with itself: time to contact 'never' (its rigid motion closes no gap).
+rim edge-on    a plate (h_a 20 mm, 1 m square, 2 x 2 cells) in z = 0 and a finer plate (h_b 10 mm,
+               0.4 x 0.5 m, 4 x 4 cells, the impactor) standing in x = 1.1, its mid row of nodes
+               at z = 0, moving at (-2, 0, 0) m/s: its nodes meet plate a's rim, rounded by h_a/2
+               all round, with their own face h_b/2 along x: gap 0.1 - h_b/2 - h_a/2 = 0.085 m,
+               closing 2 m/s, time 0.0425 s (with passes = 2 the rim is not rounded and the edge
+               met edge-on has no face: 0.095 m).
 denser target  a thin tube (R 40 mm, width 120 mm, 16 x 3 cells) listed as the target of a plate
                (0.3 m, 8 x 8 cells): the warning gives the plate's area per node over the tube's,
                (0.3^2 / 25^2) / (2 pi R w / (48 x 10)) = 2.29, within 1%; listed the other way
@@ -122,6 +128,16 @@ got = check("sphere_at_rest", ring_obstacles(0.0))
 ball = got.get(("ring", "ball"), (None,) * 3)
 ck.record("sphere at rest above a ring moving down: 'never'", ("ring", "ball") in got and ball[2] is None
           and ball[1] is not None and ball[1] < 0, str(ball))
+for passes, gap in ((1, 0.1 - 0.005 - 0.01), (2, 0.1 - 0.005)):
+    got = check("rim_edge_on_%d" % passes, f"""&run dt = 1e-5, t_end = 1e-3 /
+&body name = 'a', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 2, ny = 2, {STEEL}, thickness = 0.02 /
+&body name = 'b', mesh = 'plate', lx = 0.4, ly = 0.5, nx = 4, ny = 4, rotate_axis = 0, 1, 0,
+  rotate_angle = 90, center = 1.1, 0.25, 0.2, velocity = -2, 0, 0, {STEEL}, thickness = 0.01 /
+&contact passes = {passes} /
+""")
+    ba = got.get(("b", "a"), (None,) * 3)
+    close("rim met edge-on, passes = %d: gap [m]" % passes, ba[0], gap)
+    close("rim met edge-on, passes = %d: time to contact [s]" % passes, ba[2], gap / 2.0)
 # a thin tube (R 40 mm, 120 mm, 16 x 3 cells) listed as the target of a coarse plate (0.3 m,
 # 8 x 8 cells): the tube's area per node, 2 pi R w / (3*16 (3*3 + 1)), is the plate's
 # 0.3^2 / 25^2 over 2.29; with one pass the warning names that ratio, listed the other way

@@ -27,7 +27,7 @@ module casca_contact_projection
   implicit none
   private
   public :: positions, body_box, project, constraint_geometry, constraint_entries, constraint_row, face, &
-            force_point, row_factors, normal_cache_t, normal_cache
+            force_point, row_factors, normal_cache_t, normal_cache, on_rim
 
   !> The targets' element normals at their nodes for one set of positions, each made when a
   !> nodal normal first needs it: neighbouring constraints share nodes, and each normal sums

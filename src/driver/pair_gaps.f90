@@ -1,8 +1,9 @@
 !> What `casca check` says about each contact pair at t = 0: the smallest gap between the
 !> surfaces in contact (faces: mid-surfaces less half of each reference thickness along the
 !> fibre, as a constraint measures it: (h/2)|G.u|, none for a shell met edge-on, its fibre
-!> more than 60 degrees from the line u; 'mid': the mid-surfaces) and the time to contact at
-!> the bodies' initial velocities.
+!> more than 60 degrees from the line u, but h/2 all round for a target's rim met by a
+!> one-pass pair's node, rounded as projection.f90 rounds it; 'mid': the mid-surfaces) and
+!> the time to contact at the bodies' initial velocities.
 !>
 !> The contact's own probe only sees nodes within the search radius, so the distance here is
 !> computed from scratch, for bodies at any distance: every impactor node against every
@@ -21,8 +22,8 @@ module casca_pair_gaps
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
   use casca_closest_point, only: closest_point_triangle
-  use casca_contact, only: contact_t
-  use casca_contact_projection, only: face, positions
+  use casca_contact, only: contact_t, tested_both_ways
+  use casca_contact_projection, only: face, positions, on_rim
   implicit none
   private
   public :: pair_gap_t, pair_gaps, pair_gaps_at, pair_gap_lines
@@ -44,9 +45,11 @@ contains
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: x(:, :), g(:, :), v(:, :)
     type(pair_gap_t) :: pg(c%npairs)
-    integer :: ip, bi, bt, n, it, k, best_tri, region
-    real(dp) :: nrm(3), d, q(3), bary(3), dist, best, best_bary(3), best_q(3), u(3), vt(3), gap
+    integer :: ip, bi, bt, n, it, k, best_tri, region, best_region
+    real(dp) :: nrm(3), d, q(3), bary(3), dist, best, best_bary(3), best_q(3), u(3), vt(3), gap, ft
+    logical :: rounded
     real(dp), allocatable :: lo(:, :), hi(:, :)
+    logical :: rounded_rim   !< the pair meets its target's rim rounded (one pass)
     do ip = 1, c%npairs
       bi = c%pair(1, ip); bt = c%pair(2, ip)
       associate (r => pg(ip), bd => model%body(bi))
@@ -64,6 +67,7 @@ contains
             end do
           end associate
         else
+          rounded_rim = bi /= bt .and. .not. tested_both_ways(c, bi, bt)
           associate (s => c%geo%surf(bt))
             allocate (lo(3, s%ntri), hi(3, s%ntri))
             do it = 1, s%ntri
@@ -84,14 +88,19 @@ contains
                                             x(:, s%tri(3, it)), q, bary, region)
                 dist = norm2(x(:, n) - q)
                 if (dist < best) then
-                  best = dist; best_tri = it; best_bary = bary; best_q = q
+                  best = dist; best_tri = it; best_bary = bary; best_q = q; best_region = region
                 end if
               end do
               if (best_tri == 0) cycle
               u = x(:, n) - best_q
               if (norm2(u) > 0) u = u/norm2(u)
-              gap = best - face_along(c, model, bi, g(:, n), u) - &
-                    face_along(c, model, bt, matmul(g(:, s%tri(:, best_tri)), best_bary), u)
+              rounded = c%faces .and. rounded_rim .and. on_rim(s, best_tri, best_region)
+              if (rounded) then
+                ft = 0.5_dp*model%body(bt)%thickness
+              else
+                ft = face_along(c, model, bt, matmul(g(:, s%tri(:, best_tri)), best_bary), u)
+              end if
+              gap = best - face_along(c, model, bi, g(:, n), u) - ft
               if (gap >= r%gap) cycle
               r%gap = gap; r%node = n
               vt = matmul(v(:, s%tri(:, best_tri)), best_bary)
