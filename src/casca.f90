@@ -175,6 +175,7 @@ contains
         '  plots.gp, *.png             time-history plots (gnuplot), unless &output plots = .false.', &
         '  gnuplot.log                 gnuplot''s messages', &
         '  casca.lock                  while it runs: no second run writes into the folder', &
+        '  stopped.txt                 a run that stopped early (exit 3): when, why, where to restart', &
         'exit codes: 0 done, 2 bad input (every problem of the deck listed), 3 the solver could', &
         '  not go on or an output could not be written (the last good state is kept)']
     case ('check')

@@ -24,6 +24,8 @@ Asserted about the command line itself (issue 17):
 - a misspelt body name (in &restraint, in &contact pairs) or key is named with the nearest
   one: "(did you mean 'ring2'?)", "(did you mean 'tolerance'?)"; a key of another group with
   that group: a body's pressure, "(a key of &load)".
+- a run whose solver cannot go on exits 3 and leaves stopped.txt in its folder, with the
+  stop time it printed and the deck's t_end; a finished run into the folder removes it.
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -204,6 +206,11 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("thickness not positive", lambda s: s.replace("thickness = 0.05", "thickness = 0.0", 1), ["thickness", "> 0"]),
     ("dt not positive", lambda s: s.replace("dt = 5.0e-5", "dt = -1.0e-5"), ["dt", "> 0"]),
     ("nu out of range", lambda s: s.replace("poisson = 0.3", "poisson = 0.5", 1), ["poisson", "(-1, 0.5)"]),
+    ("a velocity not a number", lambda s: s.replace("velocity = 10.0, 0.0, 0.0", "velocity = NaN, 0.0, 0.0", 1),
+     ["&body ring1: velocity must be finite", "(got NaN)"]),
+    ("three problems at once", lambda s: s.replace("dt = 5.0e-5", "dt = -1.0e-5")
+     .replace("poisson = 0.3", "poisson = 0.5", 1).replace("1.06, 0.0, 0.0\n", "1.06, 0.0\n", 1),
+     ["dt must be > 0", "poisson must be in (-1, 0.5)", "track needs 3 coordinates per point", "3 problems in the deck"]),
     ("missing mesh file", lambda s: s.replace(ring, "/no/such/ring.msh", 1), ["/no/such/ring.msh", "does not exist"]),
     ("empty mesh", lambda s: s.replace(ring, empty_msh, 1), ["empty.msh", "10-node triangles"]),
     ("degenerate element", lambda s: s.replace(ring, flat_msh, 1), ["degenerate", "ring1"]),
@@ -371,4 +378,16 @@ p = run([casca, "run", stuck, "--out", out_s, "-q"])
 ck.record("solver failure: exit 3 with a message", p.returncode == 3 and "cannot go on" in p.stderr, p.stderr[-200:])
 ck.record("solver failure: checkpoint.h5 and a last frame written",
           os.path.exists(os.path.join(out_s, "checkpoint.h5")) and os.path.exists(os.path.join(out_s, "run.pvd")))
+# the folder says the run stopped early (its history and frames are whole files), with the
+# time and reason the run printed; a later run into the folder removes the mark
+mark = os.path.join(out_s, "stopped.txt")
+text = open(mark).read() if os.path.exists(mark) else ""
+t_stop = re.search(r"cannot go on at t =\s*(\S+) s", p.stderr)
+t_mark = re.search(r"stopped at t = (\S+) s of t_end = (\S+) s", text)
+ck.record("solver failure: stopped.txt names the stop time and t_end", t_stop is not None and t_mark is not None
+          and abs(float(t_mark.group(1)) - float(t_stop.group(1))) <= 1e-4 * float(t_stop.group(1))
+          and float(t_mark.group(2)) == 3.0e-3, text)
+p = run([casca, "run", deck, "--out", out_s, "-q"])
+ck.record("a finished run into that folder removes stopped.txt", p.returncode == 0 and not os.path.exists(mark),
+          p.stderr[-200:])
 ck.finish()

@@ -20,7 +20,7 @@ module casca_run
   use casca_step_size, only: time_to_contact
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance, balance_remainder
-  use casca_output, only: output_t, output_open, output_history, output_frame, output_close, &
+  use casca_output, only: output_t, output_open, output_history, output_frame, output_close, output_mark_stopped, &
                           output_flush, output_release, output_indicator_lines
   use casca_vtu_writer, only: field_t, field
   use casca_mesh_indicator, only: indicator_line_len
@@ -46,6 +46,9 @@ module casca_run
   !> with an error-controlled step: the energy's cap (run_t%dt_cap) doubles after this many of
   !> its lengths
   real(dp), parameter :: cap_hold = 20
+  !> under &run tolerance, Newton's tolerance is at most this share of the error asked for,
+  !> and not below newton_floor (of the scene size: round-off's reach)
+  real(dp), parameter :: newton_share = 1e-5_dp, newton_floor = 1e-12_dp
   !> Saint-Venant-Kirchhoff's least thickness stretch: its uniaxial compressive stress,
   !> E lambda (lambda^2 - 1)/2, is largest at lambda = 1/sqrt(3) (squeezed)
   real(dp), parameter :: svk_limit = 1/sqrt(3._dp)
@@ -431,9 +434,14 @@ contains
         ! and a step at the shortest that was still judged too long was taken again for ever:
         ! two balls glancing with skip_idle_bodies = .false. hung at 2.7875 ms)
         r%sc%dt_min = dt/2**deck%run%max_step_cuts*(1 + 1e-9_dp)
-        ! (Newton's tolerance stays the deck's: taken from the step's, a thousandth of it, the
-        ! controlled steps of a spinning ring carried its error on: L lost 2.5%, E made 5%,
-        ! where 1e-9 keeps both to 1e-5 for the same iterations: docs/performance.md)
+        ! Newton's tolerance: the deck's, and at most newton_share of the error asked for.
+        ! Its error is left in every step, of one sign and 2/dt of it in the velocity under
+        ! the midpoint rule, and more steps carry more of it: a free hoop spinning at
+        ! tolerance = 1e-5 was further off its circle than at 1e-3 (1.4e-5 against 6.8e-7
+        ! m, L lost 5.3e-5) with 1e-9; 1e-10 keeps it to 1.3e-7 m and L to 1.6e-8. (A
+        ! thousandth of the step's error, tried before, lost 2.5% of a spinning ring's L.)
+        if (deck%run%newton_tol == unset) r%opts%tol = min(r%opts%tol, &
+          max(newton_floor, newton_share*r%sc%tol*r%sc%length/model%length))
         if (r%dt_try == 0) r%dt_try = dt
       end if
       interval = deck%output%interval
@@ -910,16 +918,21 @@ contains
     type(run_t), intent(inout) :: r
     character(len=*), intent(in) :: why
     type(error_t), allocatable :: e
+    character(len=:), allocatable :: where_kept, reason
+    reason = why   ! (why may be r%err's message, which the frame and checkpoint below reset)
     if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', r%st%t, &
-      ' s: ', why
+      ' s: ', reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
     if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
     call frame(r)
     call checkpoint(r)
     call r%ls%finish()
+    where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5 (restart with --restart)'
+    if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
+    call output_mark_stopped(r%out, 'this run stopped at t = '//rtoa(r%st%t)//' s of t_end = '// &
+                             rtoa(r%deck%run%t_end)//' s: '//reason//new_line('a')//where_kept)
     call output_close(r%out, e)
-    if (is_root()) write (0, '(a)') 'the last good state is in '//r%dir// &
-      '/checkpoint.h5 (restart with --restart) and in the last frame of '//r%dir//'/run.pvd'
+    if (is_root()) write (0, '(a)') where_kept
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
     if (is_root() .and. squeezed(r)) then

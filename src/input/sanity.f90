@@ -3,7 +3,7 @@
 module casca_sanity
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use casca_kinds, only: dp
-  use casca_deck, only: deck_t, obstacle_cfg_t, add_problem, unset, deck_file
+  use casca_deck, only: deck_t, obstacle_cfg_t, add_problem, unset, deck_file, max_track
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
   use casca_mesh_generators, only: generated_elements, max_generated_elements
   use casca_strings, only: itoa, rtoa, as_word
@@ -86,6 +86,10 @@ contains
       end if
       if (len_trim(o%dir) == 0) call add_problem(deck, l, '&output: dir is empty')
       call finite(l, '&output: track', reshape(o%track(:, 1:o%ntrack), [3*o%ntrack]))
+      if (o%ntrack < max_track) then
+        if (any(o%track(:, o%ntrack + 1) /= unset)) &
+          call add_problem(deck, l, '&output: track needs 3 coordinates per point')
+      end if
       do i = 1, o%ntrack
         if (o%track_body(i) /= '' .and. find_body(o%track_body(i)) == 0) &
           call add_problem(deck, l, '&output: track_body('//itoa(i)//') = '//no_body(o%track_body(i)))
@@ -102,9 +106,12 @@ contains
             call add_problem(deck, n, '&body: name '''//trim(b%name)//''' used twice')
         end if
         call distinct_column(n, '&body', b%name, deck%bodies(1:i - 1)%name)
-        call finite(n, '&body '//trim(b%name)//': center, rotate_axis, rotate_angle, velocity, '// &
-                    'omega or gravity', [b%center, b%rotate_axis, b%rotate_angle, b%velocity, b%omega, &
-                                         b%gravity])
+        call finite(n, '&body '//trim(b%name)//': center', b%center)
+        call finite(n, '&body '//trim(b%name)//': rotate_axis', b%rotate_axis)
+        call finite(n, '&body '//trim(b%name)//': rotate_angle', [b%rotate_angle])
+        call finite(n, '&body '//trim(b%name)//': velocity', b%velocity)
+        call finite(n, '&body '//trim(b%name)//': omega', b%omega)
+        call finite(n, '&body '//trim(b%name)//': gravity', b%gravity)
         call positive(n, '&body '//trim(b%name)//': young', b%young)
         call positive(n, '&body '//trim(b%name)//': density', b%density)
         call positive(n, '&body '//trim(b%name)//': thickness', b%thickness)

@@ -29,7 +29,12 @@ module casca_output
   implicit none
   private
   public :: output_t, output_open, output_history, output_frame, output_close, output_flush, &
-            output_release, output_indicator_lines
+            output_release, output_indicator_lines, output_mark_stopped
+
+  !> written into the output folder by a run that stopped before t_end (why, when, and the
+  !> state to restart from), removed when a run opens the folder: the history and frames of
+  !> such a run are whole, so only this says they end early
+  character(len=*), parameter :: stopped_name = 'stopped.txt'
 
   type :: output_t
     character(len=:), allocatable :: dir
@@ -126,6 +131,7 @@ contains
     if (allocated(err)) return
     out%locked = .true.
     if (note /= '') write (0, '(a)') 'warning: '//note
+    call delete_file(out%dir//'/'//stopped_name)   ! (an earlier run's)
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
     cols = history_columns(size(tracked), bodies, pairs, friction, moving)
@@ -477,6 +483,16 @@ contains
     if (.not. allocated(err)) call h5_table_close(out%h5, err)
     call output_release(out)
   end subroutine output_close
+
+  !> The run stopped early: say so in the folder (stopped_name), with the text given
+  subroutine output_mark_stopped(out, text)
+    type(output_t), intent(in) :: out
+    character(len=*), intent(in) :: text
+    type(error_t), allocatable :: e
+    if (.not. is_root()) return
+    call write_file_atomic(out%dir//'/'//stopped_name, text//new_line('a'), e)
+    if (allocated(e)) write (0, '(a)') 'error (output): '//e%message
+  end subroutine output_mark_stopped
 
   !> After an error: close what is open, quietly (the error is reported already), and free
   !> the folder.

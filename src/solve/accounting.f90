@@ -20,7 +20,9 @@ module casca_accounting
   type :: balance_t
     real(dp) :: kinetic = 0, strain = 0, work = 0, total = 0
     real(dp) :: p(3) = 0, l(3) = 0
-    real(dp) :: p_bodies = 0   !< sum of the bodies' |p| (the momenta's scale when p sums to 0)
+    !> the momenta's scale when p sums to 0: the bodies' sqrt(2 m K) summed, at least their |p|
+    !> (two bodies thrown at each other, a body spinning in place)
+    real(dp) :: p_bodies = 0
     real(dp), allocatable :: body_kinetic(:), body_strain(:)   !< (nbody); kinetic, strain: sums
     !> the pressures' work on open surfaces at load factor 1, summed from q0 along the states
     !> accounted (one straight segment each) to q_path: carried from state to state (and in the
@@ -55,12 +57,13 @@ contains
     type(balance_t), intent(inout) :: bal
     real(dp), intent(in), optional :: factor
     real(dp) :: x(3, 20), v(3, 20), mv(3, 20), lf
-    !> kinetic (nbody), strain (nbody), L, closed pressure work, p (3 nbody), open pressure work
+    !> kinetic (nbody), strain (nbody), L, closed pressure work, p (3 nbody), open pressure
+    !> work, mass (nbody)
     real(dp), allocatable :: s(:)
     integer :: i, e, p, b, nb, pb
 
     nb = model%nbody
-    allocate (s(5*nb + 5))
+    allocate (s(6*nb + 5))
     s = 0
     lf = 1
     if (present(factor)) lf = factor
@@ -77,6 +80,7 @@ contains
       mv = matmul(v, model%emass(:, :, e))
       b = model%elem_body(e)
       s(b) = s(b) + 0.5_dp*sum(v*mv)
+      s(5*nb + 5 + b) = s(5*nb + 5 + b) + sum(model%emass(1:10, 1:10, e))
       pb = 2*nb + 4 + 3*(b - 1)   ! (the body's momentum; the total is their sum)
       s(pb + 1:pb + 3) = s(pb + 1:pb + 3) + sum(mv(:, 1:10), dim=2)
       do p = 1, 20
@@ -88,7 +92,7 @@ contains
     bal%kinetic = sum(bal%body_kinetic); bal%strain = sum(bal%body_strain)
     bal%l = s(2*nb + 1:2*nb + 3)
     bal%p = sum(reshape(s(2*nb + 5:5*nb + 4), [3, nb]), dim=2)
-    bal%p_bodies = sum(norm2(reshape(s(2*nb + 5:5*nb + 4), [3, nb]), dim=1))
+    bal%p_bodies = sum(sqrt(2*s(5*nb + 6:6*nb + 5)*s(1:nb)))
     bal%pressure_path = bal%pressure_path + s(5*nb + 5); bal%q_path = st%q
     bal%work = dot_product(fext, st%q - q0) + s(2*nb + 4) + lf*bal%pressure_path
     bal%total = bal%kinetic + bal%strain - bal%work
@@ -127,8 +131,8 @@ contains
   end subroutine gravity_load
 
   !> What the run kept, from the state first accounted (b0) to b: the drift of the linear
-  !> momentum (of |p0|, or of the bodies' |p| summed when larger: two bodies thrown at each
-  !> other have p0 = 0), of the angular momentum (of |L0|, or of that momentum scale times the
+  !> momentum (of |p0|, or of the bodies' sqrt(2 m K) summed when larger: two bodies thrown
+  !> at each other, or a hoop spinning in place, have p0 = 0), of the angular momentum (of |L0|, or of that momentum scale times the
   !> scene size when L0 is smaller) and the change of the total energy (of E0). Contact forces keep both
   !> momenta; the Newmark step itself keeps the linear one only: its angular momentum
   !> drifts with dt (docs/method.md), which is why the figure is printed.
