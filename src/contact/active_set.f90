@@ -11,7 +11,7 @@ module casca_contact_active_set
   use casca_contact_friction, only: friction_on, beyond_cone, friction_update
   implicit none
   private
-  public :: contact_update, contact_release, contact_settle, contact_solve_start
+  public :: contact_update, contact_release, contact_settle, contact_solve_start, contact_step_start
 
 contains
 
@@ -27,7 +27,7 @@ contains
     integer, intent(out) :: added
     logical, intent(in), optional :: reproject
     real(dp), allocatable :: x(:, :), q_start(:)
-    real(dp) :: boxi(3, 2), boxt(3, 2), r, reach, nrm(3), d
+    real(dp) :: boxi(3, 2), boxt(3, 2), r, reach, nrm(3), d, gs
     integer :: ip, bi, bt, n, k
     logical :: found
     type(constraint_t) :: cn
@@ -107,23 +107,30 @@ contains
         call constraint_geometry(c, model, x, q, cn, normals)
       end if
       if (cn%gap < -c%tol) then
-        if (edge_on(cn)) return
+        gs = start_gap(cn)
+        ! already between the target's faces at the step's start, not held, come in edge-on
+        ! (through the rim, past the faces) or sideways: casca has no edge contact, and
+        ! pushed out to a face in one step it made energy (a hoop past a plate's corner,
+        ! both ways round: 80% of the energy in a step). It is left free.
+        if (c%faces .and. gs < -0.25_dp*cn%off) return
+        if (gs < -c%tol .and. .not. c%probe) then   ! inside already: held where it was
+          cn%hold = gs
+          call constraint_geometry(c, model, x, q, cn, normals)
+          if (.not. cn%gap < -c%tol) return   ! (coming out by itself)
+        end if
         call constraint_geometry(c, model, x, q, cn, normals, lever=.true.)   ! (its rows' too)
         call push(cn)
         added = added + 1
       end if
     end subroutine take
 
-    !> A node that was already between the target's faces at the step's start, not held, came
-    !> in edge-on (through the rim, past the faces) or sideways: casca has no edge contact,
-    !> and pushed out to a face in one step it made energy (a hoop past a plate's corner,
-    !> both ways round: 80% of the energy in a step). It is left free.
-    logical function edge_on(cn)
+    !> cn's gap at the step's start (its point, side and faces held), huge where not known
+    real(dp) function start_gap(cn)
       type(constraint_t), intent(in) :: cn
       type(constraint_t) :: cs
       integer :: m
-      edge_on = .false.
-      if (.not. c%faces .or. cn%elem <= 0 .or. .not. allocated(c%x_start)) return
+      start_gap = huge(1._dp)
+      if (cn%elem <= 0 .or. .not. allocated(c%x_start)) return
       if (c%dt <= 0) return
       if (.not. allocated(q_start)) then
         q_start = q
@@ -134,8 +141,8 @@ contains
       end if
       cs = cn
       call constraint_geometry(c, model, c%x_start, q_start, cs)
-      edge_on = cs%gap < -0.25_dp*cn%off
-    end function edge_on
+      start_gap = cs%gap
+    end function start_gap
 
     !> a constraint needs at least one free position on either side
     logical function has_free_position(node, e)
@@ -176,6 +183,22 @@ contains
       c%act(c%nact) = con
     end subroutine push
   end subroutine contact_update
+
+  !> A new step: a depth held (constraint_t%hold) follows a node that came out part of the
+  !> way, up to the surface; it is never pushed out (gap: at the last step's end)
+  pure subroutine contact_step_start(c)
+    type(contact_t), intent(inout) :: c
+    integer :: k
+    real(dp) :: g
+    do k = 1, c%nact
+      associate (a => c%act(k))
+        if (.not. a%hold < 0) cycle
+        g = a%gap + a%hold   ! (the gap itself)
+        a%hold = min(0._dp, max(a%hold, g))
+        a%gap = g - a%hold
+      end associate
+    end do
+  end subroutine contact_step_start
 
   !> A new solve of a step: no active-set change yet; the sliding directions it starts from
   subroutine contact_solve_start(c)

@@ -11,8 +11,8 @@ module casca_contact_probes
 
 contains
 
-  !> Deepest penetration of the impactor nodes that carry no constraint (their gap) and
-  !> largest |gap| of those that do.
+  !> Deepest penetration of the impactor nodes that carry no constraint (their gap) or are
+  !> held where they were (constraint_t%hold), and largest |gap| of those that carry one.
   subroutine contact_penetration(c, model, q, free_pen, max_gap)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
@@ -28,6 +28,7 @@ contains
       if (holds(c, probe%act(k)%node, probe%act(k)%pair)) cycle
       free_pen = max(free_pen, -probe%act(k)%gap)
     end do
+    if (c%nact > 0) free_pen = max(free_pen, -minval(c%act(1:c%nact)%hold))   ! (held, not pushed out)
     max_gap = 0
     if (c%nact > 0) max_gap = maxval(abs(c%act(1:c%nact)%gap))
   end subroutine contact_penetration
@@ -64,5 +65,6 @@ contains
     probe%changes = 0
     probe%geo%grid_ok = .false.
     probe%tol = tol
+    probe%probe = .true.
   end subroutine new_probe
 end module casca_contact_probes

@@ -179,7 +179,7 @@ contains
       call obstacle_point(c%obstacle(-bt), c%time, x(:, con%node), con%n, gm)
       if (c%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
                              -con%n, con%face(1), con%off, con%wg(1), c%rim(con%node))
-      con%gap = gm - con%off
+      con%gap = gm - con%off - con%hold
       call hold_force_point(con)
       call friction_geometry()
       return
@@ -245,7 +245,7 @@ contains
         end if
       end if
     end if
-    con%gap = merge(gm, con%side*gm, rim) - con%off
+    con%gap = merge(gm, con%side*gm, rim) - con%off - con%hold
     call hold_force_point(con)
     call friction_geometry()
   contains

@@ -114,7 +114,7 @@ contains
       reals = [contact%act(1:nact)%lambda, contact%act(1:nact)%mu, &
                (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
                 k=1, nact), contact%friction_work, contact%obstacle_work, &
-               contact%impulse, contact%carry, (contact%act(k)%fa, k=1, nact)]
+               contact%impulse, contact%carry, (contact%act(k)%fa, k=1, nact), contact%act(1:nact)%hold]
     else
       ints = [level, 0]
       allocate (reals(0))
@@ -148,7 +148,7 @@ contains
     real(dp), allocatable :: reals(:)
     integer :: k, nact, node, pair, per
     character(len=:), allocatable :: bad
-    logical :: with_fa
+    logical :: with_fa, with_hold
 
     level = 0
     call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next, cs, &
@@ -284,7 +284,8 @@ contains
         contact%g_start = positions(model, st%q, fibres=.true.)
       end if
     end if
-    with_fa = size(reals) == 14*int(nact, int64) + 7*contact%npairs + 1   ! (friction's start forces)
+    with_fa = size(reals) >= 14*int(nact, int64) + 7*contact%npairs + 1   ! (friction's start forces)
+    with_hold = size(reals) == 15*int(nact, int64) + 7*contact%npairs + 1   ! (the depths held)
     do k = 1, nact
       contact%act(k) = new_constraint(ints(3 + per*(k - 1)), ints(4 + per*(k - 1)))
       contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
@@ -303,6 +304,7 @@ contains
           contact%act(k)%fa = reals(at + 1:at + 3)
         end associate
       end if
+      if (with_hold) contact%act(k)%hold = reals(14*nact + 7*contact%npairs + 1 + k)
       ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
       ! that wrote it left them
       if (contact%act(k)%elem > 0 .or. contact%pair(2, contact%act(k)%pair) <= 0) &

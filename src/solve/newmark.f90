@@ -12,6 +12,7 @@ module casca_newmark
   use casca_contact_correction, only: contact_correction, add_impulses
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
+  use casca_contact_active_set, only: contact_step_start
   use casca_contact_rows, only: add_step_impulse, contact_nrows, contact_force_points, pair_forces
   use casca_timers, only: timer_start, timer_stop, t_contact
   use casca_time_scheme, only: scheme_t
@@ -67,6 +68,7 @@ contains
       before = contact%act(1:contact%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
       contact%x_start = positions(model, st%q); contact%dt = dt
+      call contact_step_start(contact)
       contact%alpha_f = nm%alpha_f; contact%act(1:contact%nact)%g0 = contact%act(1:contact%nact)%gap
       contact%g_start = positions(model, st%q, fibres=.true.)   ! (friction's slip)
     end if
