@@ -195,9 +195,9 @@ contains
       end if
     end if
     ! 7 integers (node, pair, elem, side, faces, grip) and 2 + 9 reals (lambda, mu; xi, lt,
-    ! mut, s) per constraint, then the works (npairs + 1), the impulses (6 npairs) and
-    ! friction's start forces (3 nact) (the last two absent from earlier checkpoints: taken as
-    ! 0); a checkpoint of casca before these were kept has
+    ! mut, s) per constraint, then the works (npairs + 1), the impulses (6 npairs),
+    ! friction's start forces (3 nact) and the depths held (nact) (the last three absent from
+    ! earlier checkpoints: taken as 0); a checkpoint of casca before these were kept has
     ! 2 and 1 (node, pair; lambda): it is read, point, side and faces chosen again at the
     ! restart, mu taken as 0, the works as 0
     per = 7
@@ -207,7 +207,8 @@ contains
       else if (size(ints) /= 2 + 7*int(nact, int64) .or. &
                (size(reals) /= 11*int(nact, int64) + contact%npairs + 1 .and. &
                 size(reals) /= 11*int(nact, int64) + 7*contact%npairs + 1 .and. &
-                size(reals) /= 14*int(nact, int64) + 7*contact%npairs + 1)) then
+                size(reals) /= 14*int(nact, int64) + 7*contact%npairs + 1 .and. &
+                size(reals) /= 15*int(nact, int64) + 7*contact%npairs + 1)) then
         bad = 'its contact count '//itoa(nact)//' does not match its contact data'
       end if
       if (bad == '' .and. .not. all(ieee_is_finite(reals))) bad = 'its contact forces are not finite'
