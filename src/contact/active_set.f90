@@ -113,7 +113,8 @@ contains
         ! pushed out to a face in one step it made energy (a hoop past a plate's corner,
         ! both ways round: 80% of the energy in a step). It is left free.
         if (c%faces .and. gs < -0.25_dp*cn%off) return
-        if (gs < -c%tol .and. .not. c%probe) then   ! inside already: held where it was
+        ! inside already: held where it was (a compliant contact's node is inside by design)
+        if (gs < -c%tol .and. .not. (c%probe .or. c%compliance(cn%node) > 0)) then
           cn%hold = gs
           call constraint_geometry(c, model, x, q, cn, normals)
           if (.not. cn%gap < -c%tol) return   ! (coming out by itself)
