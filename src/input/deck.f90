@@ -517,6 +517,7 @@ contains
       checkpoint_interval = c%checkpoint_interval
       track = unset; track_body = ''
       c%line = line
+      c%track = track   ! (no point tracked, even with no &output group: sanity.f90 reads it)
       if (line == 0) return
       rewind (u)
       read (u, nml=output, iostat=ios, iomsg=msg)
