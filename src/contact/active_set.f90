@@ -13,12 +13,6 @@ module casca_contact_active_set
   private
   public :: contact_update, contact_release, contact_settle, contact_solve_start, contact_step_start
 
-  !> after this many changes of the set in a solve, tensile constraints are released one at a
-  !> time, the most tensile first: released together, two nodes of a hoop spinning onto a
-  !> floor with friction penetrated again and were taken again, and the set went 3, 1, 3, 1
-  !> until the step was cut (validator's F3)
-  integer, parameter :: one_by_one = 6
-
 contains
 
   !> Refresh the active constraints (normal and gap at their point; with reproject, the point
@@ -243,8 +237,7 @@ contains
     changed = released + added
   end subroutine contact_settle
 
-  !> Release the constraints whose multiplier is tensile (lambda > 0), or only the most
-  !> tensile after one_by_one changes in the solve; how many were released.
+  !> Release the constraints whose multiplier is tensile (lambda > 0); how many were released.
   !> keep_stuck: not a sticking one outside Coulomb's cone (at an iterate that is not
   !> converged, where stick and slip wait): its tension may come from the stick force alone
   !> (a plate landing flat while it spins, every node stuck at first: the stick forces at the
@@ -253,21 +246,10 @@ contains
     type(contact_t), intent(inout) :: c
     integer, intent(out) :: released
     logical, intent(in) :: keep_stuck
-    integer :: k, m, only
-    real(dp) :: most
-    only = 0
-    if (c%changes >= one_by_one) then
-      most = 0
-      do k = 1, c%nact
-        if (c%act(k)%lambda > most .and. .not. (keep_stuck .and. beyond_cone(c, c%act(k)))) then
-          most = c%act(k)%lambda; only = k
-        end if
-      end do
-    end if
+    integer :: k, m
     m = 0
     do k = 1, c%nact
-      if (c%act(k)%lambda > 0 .and. .not. (keep_stuck .and. beyond_cone(c, c%act(k))) .and. &
-          (only == 0 .or. k == only)) cycle
+      if (c%act(k)%lambda > 0 .and. .not. (keep_stuck .and. beyond_cone(c, c%act(k)))) cycle
       m = m + 1
       c%act(m) = c%act(k)
     end do
