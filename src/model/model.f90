@@ -22,6 +22,8 @@ module casca_model
     real(dp) :: young = 0, poisson = 0, density = 0, thickness = 0, lam = 0, mu = 0
     integer :: node_first = 0, node_last = -1, elem_first = 0, elem_last = -1
     real(dp) :: gravity(3) = 0   !< the run's and the body's own [m/s^2]
+    !> [kg]: the consistent mass's Y-Y entries of one component summed (model_finalize)
+    real(dp) :: mass = 0
   end type body_t
 
   type :: model_t
@@ -173,6 +175,9 @@ contains
       end if
       call shell_mass(mrule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), h, &
                       model%body(model%elem_body(e))%density, model%emass(:, :, e))
+      associate (bd => model%body(model%elem_body(e)))
+        bd%mass = bd%mass + sum(model%emass(1:10, 1:10, e))
+      end associate
     end do
     allocate (model%fixed(model%ndof), model%fext(model%ndof))
     model%fixed = .false.; model%fext = 0

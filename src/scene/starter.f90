@@ -74,11 +74,11 @@ contains
                x => model%x0(:, model%body(b)%node_first:model%body(b)%node_last))
       f%nodes = bd%node_last - bd%node_first + 1
       f%elements = bd%elem_last - bd%elem_first + 1
+      f%mass = bd%mass
       f%lo = minval(x, dim=2); f%hi = maxval(x, dim=2)
       f%l_min = huge(1._dp)
       f%quality = huge(1._dp)
       do e = bd%elem_first, bd%elem_last
-        f%mass = f%mass + sum(model%emass(1:nen, 1:nen, e))
         f%area = f%area + element_area(model, e)
         f%l_min = min(f%l_min, shortest_edge(model%x0(:, model%conn(1:3, e))))
         q = element_quality(model, e)

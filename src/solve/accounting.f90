@@ -57,13 +57,12 @@ contains
     type(balance_t), intent(inout) :: bal
     real(dp), intent(in), optional :: factor
     real(dp) :: x(3, 20), v(3, 20), mv(3, 20), lf
-    !> kinetic (nbody), strain (nbody), L, closed pressure work, p (3 nbody), open pressure
-    !> work, mass (nbody)
+    !> kinetic (nbody), strain (nbody), L, closed pressure work, p (3 nbody), open pressure work
     real(dp), allocatable :: s(:)
     integer :: i, e, p, b, nb, pb
 
     nb = model%nbody
-    allocate (s(6*nb + 5))
+    allocate (s(5*nb + 5))
     s = 0
     lf = 1
     if (present(factor)) lf = factor
@@ -80,7 +79,6 @@ contains
       mv = matmul(v, model%emass(:, :, e))
       b = model%elem_body(e)
       s(b) = s(b) + 0.5_dp*sum(v*mv)
-      s(5*nb + 5 + b) = s(5*nb + 5 + b) + sum(model%emass(1:10, 1:10, e))
       pb = 2*nb + 4 + 3*(b - 1)   ! (the body's momentum; the total is their sum)
       s(pb + 1:pb + 3) = s(pb + 1:pb + 3) + sum(mv(:, 1:10), dim=2)
       do p = 1, 20
@@ -92,7 +90,7 @@ contains
     bal%kinetic = sum(bal%body_kinetic); bal%strain = sum(bal%body_strain)
     bal%l = s(2*nb + 1:2*nb + 3)
     bal%p = sum(reshape(s(2*nb + 5:5*nb + 4), [3, nb]), dim=2)
-    bal%p_bodies = sum(sqrt(2*s(5*nb + 6:6*nb + 5)*s(1:nb)))
+    bal%p_bodies = sum(sqrt(2*model%body(:)%mass*s(1:nb)))
     bal%pressure_path = bal%pressure_path + s(5*nb + 5); bal%q_path = st%q
     bal%work = dot_product(fext, st%q - q0) + s(2*nb + 4) + lf*bal%pressure_path
     bal%total = bal%kinetic + bal%strain - bal%work
