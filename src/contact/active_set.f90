@@ -117,8 +117,7 @@ contains
         ! inside by design, and between mid-surfaces a thin ring's node that came through the
         ! target's one side is taken back, as before: held, one stayed 0.63 mm behind it)
         if (c%faces .and. gs < -c%tol .and. .not. (c%probe .or. c%compliance(cn%node) > 0)) then
-          cn%hold = gs
-          call constraint_geometry(c, model, x, q, cn, normals)
+          cn%hold = gs; cn%gap = cn%gap - gs   ! (constraint_geometry's gap, less the depth)
           if (.not. cn%gap < -c%tol) return   ! (coming out by itself)
         end if
         call constraint_geometry(c, model, x, q, cn, normals, lever=.true.)   ! (its rows' too)
