@@ -178,8 +178,8 @@ contains
 
         ! f_p = c P : (A0^-T dA1/dq_p): each dA1/dq_p is a combination of the shape
         ! functions' values times e_k (x) b(k, :), so the point adds three vectors pbk to
-        ! sums that the area point spreads over the nodes (a fifth of the work of forming
-        ! every v_p, which only the Hessian needs)
+        ! sums that the area point spreads over the nodes, without forming every v_p, which
+        ! only the Hessian needs (the force alone in a third of the time: bench_solver)
         pb1 = c*matmul(pm, b(1, :)); pb2 = c*matmul(pm, b(2, :)); pb3 = c*matmul(pm, b(3, :))
         fp1 = fp1 + pb1; fp2 = fp2 + pb2
         fq1 = fq1 + s*pb1; fq2 = fq2 + s*pb2; fq3 = fq3 + s1*pb1 + s2*pb2 + s3*pb3
