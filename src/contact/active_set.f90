@@ -1,7 +1,7 @@
 !> The active set: which impactor nodes carry a constraint. Detection adds the nodes that
 !> penetrate their target; release drops the constraints whose multiplier turned tensile.
 module casca_contact_active_set
-  use casca_kinds, only: dp
+  use casca_kinds, only: dp, i8
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
   use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, holds, new_constraint, &
@@ -207,6 +207,7 @@ contains
     type(contact_t), intent(inout) :: c
     integer :: k
     c%changes = 0
+    c%nseen = 0; c%cycling = .false.
     c%follow_slip = .false.; c%hold_slip = .false.
     c%act(1:c%nact)%flips = 0
     do k = 1, c%nact
@@ -234,7 +235,34 @@ contains
     call contact_release(c, released, keep_stuck=.not. stick)
     call contact_update(c, model, q, .true., added, reproject=.false.)
     changed = released + added
+    if (changed > 0) call remember_set(c)
   end subroutine contact_settle
+
+  !> Note the set Newton goes on with; one it had already converged for in this solve is a
+  !> cycle (a hoop rolling on a floor under friction: three constraints, two of them tensile,
+  !> released together; then both penetrating, taken again), broken by releasing one at a time
+  subroutine remember_set(c)
+    type(contact_t), intent(inout) :: c
+    integer(i8) :: key(2)
+    key = set_key(c)
+    if (any(c%seen(1, 1:c%nseen) == key(1) .and. c%seen(2, 1:c%nseen) == key(2))) c%cycling = .true.
+    if (c%nseen == size(c%seen, 2)) return
+    c%nseen = c%nseen + 1
+    c%seen(:, c%nseen) = key
+  end subroutine remember_set
+
+  !> Two sums over the active constraints, of the (node, pair) numbers and of their squares:
+  !> the same for the same set, whatever its order
+  pure function set_key(c) result(key)
+    type(contact_t), intent(in) :: c
+    integer(i8) :: key(2), m
+    integer :: k
+    key = 0
+    do k = 1, c%nact
+      m = int(c%act(k)%node, i8)*int(c%npairs + 1, i8) + c%act(k)%pair
+      key = key + [m, m*m]
+    end do
+  end function set_key
 
   !> Release the constraints whose multiplier is tensile (lambda > 0); how many were released.
   !> keep_stuck: not a sticking one outside Coulomb's cone (at an iterate that is not
@@ -245,15 +273,30 @@ contains
     type(contact_t), intent(inout) :: c
     integer, intent(out) :: released
     logical, intent(in) :: keep_stuck
-    integer :: k, m
+    integer :: k, m, only
+    real(dp) :: most
+    only = 0   ! (every tensile one)
+    if (c%cycling) then   ! only the most tensile
+      most = 0
+      do k = 1, c%nact
+        if (tensile(c%act(k)) .and. c%act(k)%lambda > most) then
+          most = c%act(k)%lambda; only = k
+        end if
+      end do
+    end if
     m = 0
     do k = 1, c%nact
-      if (c%act(k)%lambda > 0 .and. .not. (keep_stuck .and. beyond_cone(c, c%act(k)))) cycle
+      if (tensile(c%act(k)) .and. (only == 0 .or. k == only)) cycle
       m = m + 1
       c%act(m) = c%act(k)
     end do
     released = c%nact - m
     c%nact = m
     if (released > 0) c%changes = c%changes + 1
+  contains
+    logical function tensile(a)
+      type(constraint_t), intent(in) :: a
+      tensile = a%lambda > 0 .and. .not. (keep_stuck .and. beyond_cone(c, a))
+    end function tensile
   end subroutine contact_release
 end module casca_contact_active_set

@@ -10,7 +10,7 @@
 !> constraint), active_set.f90 (detection and release), rows.f90 (C, forces), correction.f90
 !> (the velocity after a step), probes.f90 (diagnostics).
 module casca_contact
-  use casca_kinds, only: dp
+  use casca_kinds, only: dp, i8
   use casca_model, only: model_t
   use casca_shape_tri10, only: tri10_shape, tri10_node_xi
   use casca_surface_search, only: surface_t, grid_t, surface_init
@@ -148,6 +148,11 @@ module casca_contact
     integer :: nact = 0
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
+    !> the sets this solve has settled into (active_set.f90's set_key), and whether it came
+    !> back to one of them: then tensile constraints go one at a time
+    integer(i8) :: seen(2, 16) = 0
+    integer :: nseen = 0
+    logical :: cycling = .false.
   end type contact_t
 
 contains
