@@ -7,8 +7,11 @@ Scenes written for this test; every expected figure is the hand-computed geometr
 figures are compared to 1e-6 relative):
 rings faces    two thesis rings (R 1, h 0.05), centres 2.1 m apart, ring1 at (10, 3, 0) m/s, ring2
                at (4, 0, 0) m/s: gap 2.1 - 2R - h = 0.05 m (node facing node), closing speed
-               10 - 4 = 6 m/s (along x, the line of closest approach), time 0.05 / 6 s.
-rings mid      the same with surface = 'mid': gap 0.1 m, time 0.1 / 6 s.
+               10 - 4 = 6 m/s (along x, the line of closest approach); time to contact no earlier
+               than gap / 6 s (the nearest nodes' straight approach) and no later than the
+               circles' rigid contact, |(2.1, 0) - (6, 3) t| = 2R + h, plus two chords' sagittas
+               (60 nodes around) at 6 m/s.
+rings mid      the same with surface = 'mid': gap 0.1 m, the circles touching at 2R.
 rings between  ring2 turned by 3 degrees (half the 6-degree node spacing), so ring1's nearest node
                faces a chord of ring2's: the printed gap lies between the exact gap 0.05 m and
                0.05 + (R + h/2)(1 - cos 3 deg) (the chord's sagitta at the face: the accuracy the
@@ -27,7 +30,17 @@ rim edge-on    a plate (h_a 20 mm, 1 m square, 2 x 2 cells) in z = 0 and a finer
                at z = 0, moving at (-2, 0, 0) m/s: its nodes meet plate a's rim, rounded by h_a/2
                all round, with their own face h_b/2 along x: gap 0.1 - h_b/2 - h_a/2 = 0.085 m,
                closing 2 m/s, time 0.0425 s (with passes = 2 the rim is not rounded and the edge
-               met edge-on has no face: 0.095 m).
+               met edge-on has no face: 0.095 m, b's nodes, moving along a's plane, meet none of
+               its faces: 'never'; a's rim nodes meet b's face at 0.095 / 2 s).
+ring in ring   a small ring (R 0.08, 16 cells) at the centre of a big one (R 0.2, 40 cells), both
+               h 2 mm, the small one at 20 m/s along x: its node at angle 0 meets the big ring's
+               node there first, at (0.2 - 0.08 - h) / 20 s; the big ring's chords lie inside
+               its circle, so the time printed is within that less the chord's sagitta at the
+               face over 20 m/s. 0.06 m off the axis: the circles' rigid contact at
+               sqrt(0.118^2 - 0.06^2) / 20 s, less the big ring's sagitta and plus the small
+               one's over the closing speed along the wall's normal. (Before 2026-11-28 the time
+               was the closest node's gap over its speed: the centred ring's nearest nodes moved
+               sideways, and off the axis it came 19% late.)
 denser target  a thin tube (R 40 mm, width 120 mm, 16 x 3 cells) listed as the target of a plate
                (0.3 m, 8 x 8 cells): the warning gives the plate's area per node over the tube's,
                (0.3^2 / 25^2) / (2 pi R w / (48 x 10)) = 2.29, within 1%; listed the other way
@@ -83,11 +96,19 @@ def rings(surface, turn=0.0):
 """
 
 
+sag6 = R * (1 - math.cos(math.radians(3.0)))   # (a chord's sagitta: 60 nodes around)
 for surface, gap in (("faces", 2.1 - 2 * R - h), ("mid", 2.1 - 2 * R)):
     pr = check("rings_" + surface, rings(surface)).get(("ring1", "ring2"), (None,) * 3)
     close("rings %s: gap [m]" % surface, pr[0], gap)
     close("rings %s: closing speed [m/s]" % surface, pr[1], 6.0)
-    close("rings %s: time to contact [s]" % surface, pr[2], gap / 6.0)
+    # the circles' rigid contact: |(2.1, 0) - (6, 3) t| = 2.1 - gap
+    a, b, cc = 45.0, -25.2, 2.1**2 - (2.1 - gap) ** 2
+    t_c = (-b - math.sqrt(b * b - 4 * a * cc)) / (2 * a)
+    t = pr[2]
+    ck.record("rings %s: time to contact within [gap / 6 m/s, the circles' rigid contact + two "
+              "chords' sagittas / 6 m/s]" % surface,
+              t is not None and gap / 6 * (1 - 1e-6) <= t <= (t_c + 2 * sag6 / 6) * (1 + 1e-6),
+              "%s in [%.8g, %.8g]" % (t, gap / 6, t_c + 2 * sag6 / 6))
 
 pr = check("rings_between", rings("faces", 3.0)).get(("ring1", "ring2"), (None,) * 3)
 exact, sag = 2.1 - 2 * R - h, (R + h / 2) * (1 - math.cos(math.radians(3.0)))
@@ -137,7 +158,38 @@ for passes, gap in ((1, 0.1 - 0.005 - 0.01), (2, 0.1 - 0.005)):
 """)
     ba = got.get(("b", "a"), (None,) * 3)
     close("rim met edge-on, passes = %d: gap [m]" % passes, ba[0], gap)
-    close("rim met edge-on, passes = %d: time to contact [s]" % passes, ba[2], gap / 2.0)
+    if passes == 1:
+        close("rim met edge-on, passes = 1: time to contact [s]", ba[2], gap / 2.0)
+    else:   # (b's nodes move along a's plane: a's rim nodes meet b's face)
+        ck.record("rim met edge-on, passes = 2: b's nodes meet no face of a: 'never'", ba[2] is None, str(ba))
+        close("rim met edge-on, passes = 2: a's nodes meet b's face at [s]",
+              got.get(("a", "b"), (None,) * 3)[2], gap / 2.0)
+def ring_in_ring(name, y):
+    return check(name, f"""&run dt = 2e-5, t_end = 1e-3 /
+&body name = 'big', mesh = 'ring', radius = 0.2, width = 0.02, n_around = 40, n_across = 1, {STEEL},
+  thickness = 0.002 /
+&body name = 'small', mesh = 'ring', radius = 0.08, width = 0.02, n_around = 16, n_across = 1,
+  center = 0, {y}, 0, velocity = 20, 0, 0, {STEEL}, thickness = 0.002 /
+&contact pairs = 'small', 'big' /
+""").get(("small", "big"), (None,) * 3)
+
+
+sb = ring_in_ring("ring_in_ring", 0.0)
+t_lead = (0.2 - 0.08 - 0.002) / 20
+sag = (0.2 - 0.001) * (1 - math.cos(math.radians(1.5)))
+ck.record("ring in ring: time to contact within [(gap - sagitta) / v, gap / v] of the leading node",
+          sb[2] is not None and (t_lead - sag / 20) * (1 - 1e-6) <= sb[2] <= t_lead * (1 + 1e-6), str(sb))
+# 0.06 m off the axis: the centres (20 t, 0.06) are 0.118 m apart at t = sqrt(0.118^2 - 0.06^2) / 20,
+# the wall's normal there 30.6 degrees from the path; the big ring's chords lie inside its circle
+# (up to 0.199 (1 - cos 1.5 deg) nearer), the small one's inside its own (0.081 (1 - cos 3.75 deg))
+sb = ring_in_ring("ring_in_ring_off", 0.06)
+t_c = math.sqrt(0.118**2 - 0.06**2) / 20
+vn = 20 * t_c * 20 / 0.118   # (the closing speed along the normal at contact)
+lo_t, hi_t = t_c - sag / vn, t_c + 0.081 * (1 - math.cos(math.radians(3.75))) / vn
+ck.record("ring in ring off the axis: time to contact within the circles' rigid contact less the big "
+          "ring's sagitta, plus the small one's, over the normal closing speed",
+          sb[2] is not None and lo_t * (1 - 1e-6) <= sb[2] <= hi_t * (1 + 1e-6),
+          "%s in [%.8g, %.8g]" % (sb[2], lo_t, hi_t))
 # a thin tube (R 40 mm, 120 mm, 16 x 3 cells) listed as the target of a coarse plate (0.3 m,
 # 8 x 8 cells): the tube's area per node, 2 pi R w / (3*16 (3*3 + 1)), is the plate's
 # 0.3^2 / 25^2 over 2.29; with one pass the warning names that ratio, listed the other way

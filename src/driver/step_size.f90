@@ -13,8 +13,8 @@ module casca_step_size
 
 contains
 
-  !> The earliest time to contact of the pairs (straight-line motion from the gaps and closing
-  !> speeds at the closest approaches, casca_pair_gaps) when no constraint is active and a
+  !> The earliest time to contact of the pairs within dt (each node's straight path,
+  !> casca_pair_gaps) when no constraint is active and a
   !> body could reach another within two steps of dt; huge when none is predicted. Moving
   !> obstacles are left out (pair_gaps places them where they start).
   real(dp) function time_to_contact(c, model, q, qd, dt) result(t)
@@ -30,7 +30,7 @@ contains
     far = .true.
     call clear_near_contact(model, q, qd, dt, c, far)
     if (all(far)) return
-    pg = pair_gaps_at(c, model, q, qd)
+    pg = pair_gaps_at(c, model, q, qd, dt)
     do k = 1, size(pg)
       if (pg(k)%time >= 0) t = min(t, pg(k)%time)
     end do
