@@ -216,6 +216,14 @@ p = run([casca, "run", deck("stale", t_end="5.0e-4", out=lock_out), "-q"])
 ck.record("a lock left by a dead process is taken over, with a warning (exit 0)",
           p.returncode == 0 and "took over" in p.stderr and str(dead.pid) in p.stderr
           and not os.path.exists(os.path.join(lock_out, "casca.lock")), first_line(p))
+zombie = subprocess.Popen(["true"])   # (not waited for: dead, not yet reaped, as a run just killed)
+time.sleep(0.5)
+with open(os.path.join(lock_out, "casca.lock"), "w") as f:
+    f.write("%d\n" % zombie.pid)
+p = run([casca, "run", deck("zombie", t_end="5.0e-4", out=lock_out), "-q"])
+ck.record("a lock left by a zombie process (dead, not reaped) is taken over, with a warning (exit 0)",
+          p.returncode == 0 and "took over" in p.stderr and str(zombie.pid) in p.stderr, first_line(p))
+zombie.wait()
 
 # --- shell injection: folder names from the deck and from --out and body names are only
 # names: no command runs, the folder is made with the literal name, the plots are drawn

@@ -2,7 +2,9 @@
 !> exclusively (Fortran's status='new' is open(2) with O_CREAT|O_EXCL, so of two runs exactly
 !> one gets it) and holding its process id; a second run is refused before it touches a file.
 !> A lock left by a run that died (kill -9, power cut) names a process that no longer exists
-!> (kill(pid, 0) fails): it is taken over, and the caller tells the user so.
+!> (kill(pid, 0) fails) or is a zombie, dead but not yet reaped (Linux's /proc/PID/stat says
+!> Z: a run killed under a container's init stayed so for about a second, and a restart at once
+!> was refused): it is taken over, and the caller tells the user so.
 module casca_output_lock
   use, intrinsic :: iso_c_binding, only: c_int
   use casca_error, only: error_t, fatal_error
@@ -46,7 +48,7 @@ contains
                        'be starting in '//dir//'; if none is, remove the file')
       return
     end if
-    if (pid /= c_getpid() .and. c_kill(int(pid, c_int), 0_c_int) == 0) then
+    if (pid /= c_getpid() .and. running(pid)) then
       call fatal_error(err, dir//' is in use by another casca run (process '//itoa(pid)// &
                        ', '//dir//lock_name//'); give this run another folder (--out)')
       return
@@ -62,6 +64,22 @@ contains
     note = 'took over '//dir//lock_name//' of process '//itoa(pid)// &
            ', which no longer runs (an earlier run ended without removing it)'
   end subroutine lock_folder
+
+  !> Whether process pid exists and is not a zombie
+  logical function running(pid)
+    integer, intent(in) :: pid
+    character(len=512) :: line
+    integer :: u, ios, k
+    running = c_kill(int(pid, c_int), 0_c_int) == 0
+    if (.not. running) return
+    open (newunit=u, file='/proc/'//itoa(pid)//'/stat', status='old', action='read', iostat=ios)
+    if (ios /= 0) return   ! (no /proc: kill's answer)
+    read (u, '(a)', iostat=ios) line
+    close (u)
+    if (ios /= 0) return
+    k = index(line, ')', back=.true.)   ! (the state follows the command's name in brackets)
+    if (k > 0 .and. k + 2 <= len(line)) running = .not. (line(k + 2:k + 2) == 'Z' .or. line(k + 2:k + 2) == 'X')
+  end function running
 
   !> Give the lock back (only if this process holds it).
   subroutine unlock_folder(dir)
