@@ -149,7 +149,8 @@ module casca_contact
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
     !> the sets this solve has settled into (active_set.f90's set_key), and whether it came
-    !> back to one of them: then tensile constraints go one at a time
+    !> back to one of them: then tensile constraints go one at a time, and nodes arriving
+    !> with a slip Coulomb cannot stop come in sliding
     integer(i8) :: seen(2, 16) = 0
     integer :: nseen = 0
     logical :: cycling = .false.
