@@ -23,7 +23,8 @@ Asserted about the command line itself (issue 17):
   gnuplot.log instead (so the scene does provoke it).
 - a misspelt body name (in &restraint, in &contact pairs) or key is named with the nearest
   one: "(did you mean 'ring2'?)", "(did you mean 'tolerance'?)"; a key of another group with
-  that group: a body's pressure, "(a key of &load)".
+  that group: a body's pressure, "(a key of &load)"; a list where one string goes (fix =
+  'x', 'y') with how to write it.
 - a run whose solver cannot go on exits 3 and leaves stopped.txt in its folder, with the
   stop time it printed and the deck's t_end; a finished run into the folder removes it.
 Then the deck checks and a short run's output files (see the checks' names).
@@ -229,6 +230,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("a key of another group", lambda s: s.replace("young = 210e9, ", "young = 210e9, pressure = 1e3, ", 1),
      ["&body", "unknown key 'pressure'", "(a key of &load)"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
+    ("fix given as a list", lambda s: s + "&restraint\n body = 'ring2', fix = 'x', 'y'\n/\n",
+     ["&restraint", "fix takes one string, 2 given: its components in one, fix = 'x y z'", ":19:"]),
     ("a byte-order mark", lambda s: "\ufeff" + s, ["byte-order mark", ":1:"]),
     ("a group left open", lambda s: s.replace("  interval = 5.0e-4\n", "  interval = 5.0e-4,\n", 1)
      .replace("  track_body = 'ring1', 'ring2'\n/\n", "  track_body = 'ring1', 'ring2'\n", 1),

@@ -55,6 +55,9 @@ module casca_deck_lint
     key_t('obstacle', 'velocity', 'r'), key_t('obstacle', 'friction', 'r'), &
     key_t('obstacle', 'static_friction', 'r'), key_t('obstacle', 'inside', 'l')]
 
+  !> The string keys that take a list (every other string key takes one)
+  character(len=10), parameter :: str_lists(*) = [character(len=10) :: 'track_body', 'pairs', 'bodies']
+
   !> The keys that are vectors of three, in every group they belong to
   character(len=11), parameter :: vec3(*) = [character(len=11) :: 'gravity', 'rotate_axis', &
     'center', 'velocity', 'omega', 'box_min', 'box_max', 'force', 'point', 'normal', 'axis']
@@ -240,9 +243,21 @@ contains
     end subroutine once
 
     !> The key just read is complete: a vector of three takes three numbers (the read fills
-    !> what is missing from the default and drops nothing: velocity = 1.0, 2.0 ran with vz 0)
+    !> what is missing from the default and drops nothing: velocity = 1.0, 2.0 ran with vz 0);
+    !> a string key takes one string unless it is a list (fix = 'x','y','z' met gfortran's
+    !> "Cannot match namelist object name 'y''z'", or "End of file" in the deck's last group)
     subroutine key_done()
-      if (key == '' .or. t /= 'r' .or. indexed) return
+      if (key == '' .or. indexed) return
+      if (t == 's' .and. nval > 1 .and. all(key /= str_lists)) then
+        if (key == 'fix') then
+          call report(key_line, '&'//group//': fix takes one string, '//itoa(nval)// &
+                      " given: its components in one, fix = 'x y z'")
+        else
+          call report(key_line, '&'//group//': '//key//' takes one string, '//itoa(nval)//' given')
+        end if
+        return
+      end if
+      if (t /= 'r') return
       if (all(key /= vec3)) return
       if (nval /= 3) call report(key_line, '&'//group//': '//key//' takes 3 numbers (x, y, z), '// &
                                  itoa(nval)//' given')
