@@ -251,7 +251,8 @@ contains
 
   !> Note the set Newton goes on with; one it had already converged for in this solve is a
   !> cycle (a hoop rolling on a floor under friction: three constraints, two of them tensile,
-  !> released together; then both penetrating, taken again), broken by releasing one at a time
+  !> released together; then both penetrating, taken again), broken by releasing one at a
+  !> time (contact_release) and letting nodes that arrive sliding come in so (take)
   subroutine remember_set(c)
     type(contact_t), intent(inout) :: c
     integer(i8) :: key(2)
