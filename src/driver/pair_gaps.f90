@@ -118,7 +118,8 @@ contains
               vt = matmul(v(:, s%tri(:, best_tri)), best_bary)
               speed = -dot_product(v(:, n) - vt, u)
               tn = -1
-              reach = 2*vmax*tmax + model%body(bi)%thickness + model%body(bt)%thickness
+              reach = huge(1._dp)   ! (2 vmax tmax would overflow without a horizon)
+              if (present(horizon)) reach = 2*vmax*tmax + model%body(bi)%thickness + model%body(bt)%thickness
               if (bi /= bt .and. best <= reach) tn = ray_time(c, model, s, x, g, v, bi, bt, n, lo, hi, &
                                                              vmax, tmax)
               if (rounded) then   ! (edge-on: the path need not meet a face)
