@@ -144,10 +144,22 @@ contains
       case ("'", '"')
         comma = .false.
         q = s(p:p)
-        j = index(s(p + 1:), q)
-        if (j == 0) j = n - p
-        call value(s(p:p + j), lineof(p))
-        p = p + j + 1
+        j = p + 1   ! (the closing quote: a doubled one, 'it''s', is a quote inside)
+        do
+          k = index(s(j:), q)
+          if (k == 0) then
+            j = n; exit
+          end if
+          j = j + k - 1
+          if (j < n) then
+            if (s(j + 1:j + 1) == q) then
+              j = j + 2; cycle
+            end if
+          end if
+          exit
+        end do
+        call value(s(p:j), lineof(p))
+        p = j + 1
       case default
         comma = .false.
         j = p
