@@ -61,7 +61,7 @@ contains
     real(dp) :: nrm(3), d, q(3), bary(3), dist, best, best_bary(3), best_q(3), u(3), vt(3), gap, ft, vmax, &
                 speed, tn, tl, tmax, reach
     logical :: rounded
-    real(dp), allocatable :: lo(:, :), hi(:, :)
+    real(dp), allocatable :: lo(:, :), hi(:, :), vm(:, :), gm(:, :)
     logical :: rounded_rim   !< the pair meets its target's rim rounded (one pass)
     tmax = huge(1._dp)
     if (present(horizon)) tmax = horizon
@@ -83,10 +83,12 @@ contains
         else
           rounded_rim = bi /= bt .and. .not. tested_both_ways(c, bi, bt)
           associate (s => c%geo%surf(bt))
-            allocate (lo(3, s%ntri), hi(3, s%ntri))
+            allocate (lo(3, s%ntri), hi(3, s%ntri), vm(3, s%ntri), gm(3, s%ntri))
             do it = 1, s%ntri
               lo(:, it) = minval(x(:, s%tri(:, it)), dim=2)
               hi(:, it) = maxval(x(:, s%tri(:, it)), dim=2)
+              vm(:, it) = sum(v(:, s%tri(:, it)), dim=2)/3   ! (the paths are taken relative to it)
+              gm(:, it) = sum(g(:, s%tri(:, it)), dim=2)/3
             end do
             do n = bd%node_first, bd%node_last
               best = huge(1._dp); best_tri = 0
@@ -120,15 +122,15 @@ contains
               tn = -1
               reach = huge(1._dp)   ! (2 vmax tmax would overflow without a horizon)
               if (present(horizon)) reach = 2*vmax*tmax + model%body(bi)%thickness + model%body(bt)%thickness
-              if (bi /= bt .and. best <= reach) tn = ray_time(c, model, s, x, g, v, bi, bt, n, lo, hi, &
-                                                             vmax, tmax)
+              if (bi /= bt .and. best <= reach) tn = ray_time(c, model, s, x, g(:, n), v(:, n), vm, gm, &
+                                                             bi, bt, n, lo, hi, vmax, tmax)
               if (rounded) then   ! (edge-on: the path need not meet a face)
                 tl = closing_time(gap, speed, vmax)
                 if (tl >= 0 .and. (tn < 0 .or. tl < tn)) tn = tl
               end if
               call note(r, n, gap, speed, tn)
             end do
-            deallocate (lo, hi)
+            deallocate (lo, hi, vm, gm)
           end associate
         end if
         if (bi == bt) r%time = -1
@@ -157,18 +159,18 @@ contains
     if (speed > 1e-12_dp*vmax) t = max(gap, 0._dp)/speed
   end function closing_time
 
-  !> The earliest time at which node n of body bi, moving straight on at v(:, n) relative to
-  !> each sub-triangle of surface s (at its nodes' mean velocity), comes within both faces'
-  !> offset of that sub-triangle's plane with its foot inside it; -1 if never or after tmax.
-  !> lo, hi: the sub-triangles' boxes, which a path that cannot reach them within the best time
-  !> skips.
-  real(dp) function ray_time(c, model, s, x, g, v, bi, bt, n, lo, hi, vmax, tmax) result(t)
+  !> The earliest time at which node n of body bi (fibre gn, velocity vn), moving straight on
+  !> relative to each sub-triangle of surface s (at its nodes' mean velocity vm; fibre gm),
+  !> comes within both faces' offset of that sub-triangle's plane with its foot inside it; -1
+  !> if never or after tmax. lo, hi: the sub-triangles' boxes, which a path that cannot reach
+  !> them within the best time skips.
+  real(dp) function ray_time(c, model, s, x, gn, vn, vm, gm, bi, bt, n, lo, hi, vmax, tmax) result(t)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     type(surface_t), intent(in) :: s
-    real(dp), intent(in) :: x(:, :), g(:, :), v(:, :), lo(:, :), hi(:, :), vmax, tmax
+    real(dp), intent(in) :: x(:, :), gn(3), vn(3), vm(:, :), gm(:, :), lo(:, :), hi(:, :), vmax, tmax
     integer, intent(in) :: bi, bt, n
-    real(dp) :: w(3), a(3), e1(3), e2(3), nt(3), sd, side, off, rate, th, p(3), q(3), bary(3), grow
+    real(dp) :: w(3), a(3), e1(3), e2(3), nt(3), sd, side, off, th, p(3), q(3), bary(3), grow
     integer :: it, region
     logical :: found
     found = .false.
@@ -176,7 +178,7 @@ contains
     grow = 0
     if (c%faces) grow = 0.5_dp*(model%body(bi)%thickness + model%body(bt)%thickness)
     do it = 1, s%ntri
-      w = v(:, n) - sum(v(:, s%tri(:, it)), dim=2)/3
+      w = vn - vm(:, it)
       if (.not. path_meets_box(x(:, n), w, t, lo(:, it) - grow, hi(:, it) + grow)) cycle
       a = x(:, s%tri(1, it)); e1 = x(:, s%tri(2, it)) - a; e2 = x(:, s%tri(3, it)) - a
       nt = cross(e1, e2)
@@ -184,17 +186,10 @@ contains
       nt = nt/norm2(nt)
       sd = dot_product(x(:, n) - a, nt)
       side = merge(1._dp, -1._dp, sd >= 0)
-      off = face_along(c, model, bi, g(:, n), -side*nt) + &
-            face_along(c, model, bt, sum(g(:, s%tri(:, it)), dim=2)/3, side*nt)
-      rate = -side*dot_product(w, nt)   ! (closing on the plane)
-      if (abs(sd) <= off) then
-        th = 0
-      else if (rate > 1e-12_dp*vmax) then
-        th = (abs(sd) - off)/rate
-      else
-        cycle
-      end if
-      if (th > t) cycle
+      off = face_along(c, model, bi, gn, -side*nt) + face_along(c, model, bt, gm(:, it), side*nt)
+      th = 0
+      if (abs(sd) > off) th = closing_time(abs(sd) - off, -side*dot_product(w, nt), vmax)
+      if (th < 0 .or. th > t) cycle   ! (not closing on the plane, or later)
       p = x(:, n) + th*w
       p = p - dot_product(p - a, nt)*nt   ! (its foot on the plane)
       call closest_point_triangle(p, a, a + e1, a + e2, q, bary, region)
