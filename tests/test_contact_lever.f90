@@ -130,30 +130,30 @@ contains
     real(dp) :: e_gap, e_force, e_old, mom, maxlever
     integer :: added, k
     call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .true., c)
-    c%nodal_normal = nodal
+    c%opt%nodal_normal = nodal
     call contact_update(c, model, q, .true., added)
-    call check_true(label//': constraints made ('//itoa(c%nact)//')', c%nact >= 4)
+    call check_true(label//': constraints made ('//itoa(c%set%nact)//')', c%set%nact >= 4)
     if (label == 'rim') call check_true(label//': constraints around the rim ('// &
-                                        itoa(count(c%act(1:c%nact)%side == around_rim))//')', &
-                                        count(c%act(1:c%nact)%side == around_rim) >= 4)
+                                        itoa(count(c%set%act(1:c%set%nact)%side == around_rim))//')', &
+                                        count(c%set%act(1:c%set%nact)%side == around_rim) >= 4)
     ! the gap's rows at q
     e_gap = 0; e_old = 0; maxlever = 0
-    do k = 1, c%nact
-      e_gap = max(e_gap, row_error(c, c%act(k), q, .false.))
-      old = c%act(k); old%nl = 0   ! (the row without the lever)
+    do k = 1, c%set%nact
+      e_gap = max(e_gap, row_error(c, c%set%act(k), q, .false.))
+      old = c%set%act(k); old%nl = 0   ! (the row without the lever)
       e_old = max(e_old, row_error(c, old, q, .false.))
-      maxlever = max(maxlever, real(c%act(k)%nl, dp))
+      maxlever = max(maxlever, real(c%set%act(k)%nl, dp))
     end do
-    call check_true(label//': every constraint has its lever', all(c%act(1:c%nact)%nl >= 10))
+    call check_true(label//': every constraint has its lever', all(c%set%act(1:c%set%nact)%nl >= 10))
     call check_le(label//': gap row against finite differences', e_gap, 1e-6_dp)
     call check_le(label//': (without the lever, the error is large) 1 /', 1/e_old, 10._dp)
     ! the force's rows at the midpoint of q and qn
     call contact_force_points(c, model, 0.5_dp, qn, q)
     qf = 0.5_dp*(q + qn)
     e_force = 0; mom = 0
-    do k = 1, c%nact
-      e_force = max(e_force, row_error(c, c%act(k), qf, .true.))
-      mom = max(mom, moment(c%act(k), qf))
+    do k = 1, c%set%nact
+      e_force = max(e_force, row_error(c, c%set%act(k), qf, .true.))
+      mom = max(mom, moment(c%set%act(k), qf))
     end do
     call check_le(label//': force row at the midpoint against finite differences', e_force, 1e-6_dp)
     call check_le(label//': force row: net force and moment at the midpoint', mom, 1e-10_dp)

@@ -48,13 +48,13 @@ program test_correction
   zero = 0
   call contact_init(model, reshape([1, 2], [2, 1]), [obstacle_t ::], 1e-9_dp, .false., c)
   call contact_update(c, model, st%q, .true., added)
-  call check_true('overlapping rings: several constraints found', c%nact >= 3)
+  call check_true('overlapping rings: several constraints found', c%set%nact >= 3)
   ! arbitrary smooth velocities and accelerations on every parameter
   st%qd = [(sin(0.37_dp*i) + 0.3_dp*cos(1.3_dp*i), i=1, model%ndof)]
   st%qdd = [(cos(0.11_dp*i), i=1, model%ndof)]
   call account(model, asm, st, zero, st%q, b0)
   w0 = normal_rates(st%qd)
-  allocate (nu(c%nact))
+  allocate (nu(c%set%nact))
   call contact_correction(ms, cache, c, model, st%qd, st%qdd, err, nu)
   if (allocated(err)) error stop 'correction'
   call account(model, asm, st, zero, st%q, b1)
@@ -66,8 +66,8 @@ program test_correction
   scale = sum(abs(nu))   ! the impulses' size [N s]
   call check_le('linear momentum change / sum |nu|', norm2(b1%p - b0%p)/scale, 1e-12_dp)
   moment = 0
-  do k = 1, c%nact
-    associate (con => c%act(k))
+  do k = 1, c%set%nact
+    associate (con => c%set%act(k))
       xt = 0
       do i = 1, 10
         xt = xt + con%shp(i)*st%q(dof(model%conn(i, con%elem), 1):dof(model%conn(i, con%elem), 3))
@@ -92,9 +92,9 @@ contains
     real(dp), intent(in) :: v(:)
     real(dp), allocatable :: w(:)
     integer :: kk, j
-    allocate (w(c%nact))
-    do kk = 1, c%nact
-      associate (con => c%act(kk))
+    allocate (w(c%set%nact))
+    do kk = 1, c%set%nact
+      associate (con => c%set%act(kk))
         w(kk) = dot_product(con%n, v(dof(con%node, 1):dof(con%node, 3)))
         do j = 1, 10
           w(kk) = w(kk) - con%shp(j)*dot_product(con%n, &

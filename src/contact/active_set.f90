@@ -4,8 +4,8 @@ module casca_contact_active_set
   use casca_kinds, only: dp, i8
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point
-  use casca_contact, only: contact_t, constraint_t, search_radius, face_reach, stick, slip, holds, new_constraint, &
-                           around_rim
+  use casca_contact, only: contact_t, active_set_t, constraint_t, search_radius, face_reach, stick, slip, holds, &
+                           new_constraint, around_rim
   use casca_contact_projection, only: positions, body_box, project, constraint_geometry, normal_cache_t, &
                                       normal_cache
   use casca_contact_friction, only: friction_on, beyond_cone, friction_update
@@ -37,29 +37,29 @@ contains
     allocate (x(3, model%nnode))
     x = positions(model, q)
     c%geo%grid_ok = .false.
-    if (c%nodal_normal) call normal_cache(model, normals)
+    if (c%opt%nodal_normal) call normal_cache(model, normals)
     ! active constraints: project again (the target moves and the node slides), or with
     ! reproject = .false. hold the point
-    do k = 1, c%nact
-      if (c%act(k)%grip == 0 .and. friction_on(c, c%act(k)%pair)) c%act(k)%grip = stick   ! (restart)
-      if (present(reproject) .and. (c%pair(2, c%act(k)%pair) <= 0 .or. c%act(k)%elem > 0)) then
+    do k = 1, c%set%nact
+      if (c%set%act(k)%grip == 0 .and. friction_on(c, c%set%act(k)%pair)) c%set%act(k)%grip = stick   ! (restart)
+      if (present(reproject) .and. (c%pair(2, c%set%act(k)%pair) <= 0 .or. c%set%act(k)%elem > 0)) then
         if (.not. reproject) then
-          call constraint_geometry(c, model, x, q, c%act(k), normals, lever=.true.); cycle
+          call constraint_geometry(c, model, x, q, c%set%act(k), normals, lever=.true.); cycle
         end if
       end if
-      if (c%pair(2, c%act(k)%pair) > 0) then
-        call project(c, model, x, c%act(k)%node, c%act(k)%pair, cn, found)
+      if (c%pair(2, c%set%act(k)%pair) > 0) then
+        call project(c, model, x, c%set%act(k)%node, c%set%act(k)%pair, cn, found)
         if (found) then
-          c%act(k)%elem = cn%elem; c%act(k)%xi = cn%xi; c%act(k)%sd = cn%sd
-          if ((cn%side == around_rim) .neqv. (c%act(k)%side == around_rim)) then   ! (onto or off a rim)
-            c%act(k)%side = cn%side; c%act(k)%face(2) = 0
+          c%set%act(k)%elem = cn%elem; c%set%act(k)%xi = cn%xi; c%set%act(k)%sd = cn%sd
+          if ((cn%side == around_rim) .neqv. (c%set%act(k)%side == around_rim)) then   ! (onto or off a rim)
+            c%set%act(k)%side = cn%side; c%set%act(k)%face(2) = 0
           end if
-        else if (c%act(k)%elem == 0) then   ! restored from a checkpoint, nothing to press on
-          c%act(k)%lambda = 1   ! (released at the next release)
+        else if (c%set%act(k)%elem == 0) then   ! restored from a checkpoint, nothing to press on
+          c%set%act(k)%lambda = 1   ! (released at the next release)
           cycle
         end if   ! (else far from every sub-triangle within reach: keep the last point)
       end if
-      call constraint_geometry(c, model, x, q, c%act(k), normals, lever=.true.)
+      call constraint_geometry(c, model, x, q, c%set%act(k), normals, lever=.true.)
     end do
     if (.not. detect) return
     do ip = 1, c%npairs
@@ -70,7 +70,7 @@ contains
         do n = model%body(bi)%node_first, model%body(bi)%node_last
           call obstacle_point(c%obstacle(-bt), c%time, x(:, n), nrm, d)
           if (d > reach) cycle
-          if (holds(c, n, ip) .or. all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
+          if (holds(c%set, n, ip) .or. all(model%fixed(dof(n, 1):dof(n, 3)))) cycle
           cn = new_constraint(n, ip)
           call take(cn)
         end do
@@ -87,7 +87,7 @@ contains
       reach = face_reach(c, model, bi, bt) + 0.25_dp*c%geo%depth(bt)
       do n = model%body(bi)%node_first, model%body(bi)%node_last
         if (any(x(:, n) > boxt(:, 2) + r) .or. any(x(:, n) < boxt(:, 1) - r)) cycle
-        if (holds(c, n, ip)) cycle
+        if (holds(c%set, n, ip)) cycle
         call project(c, model, x, n, ip, cn, found)
         if (.not. found) cycle
         if (cn%sd >= reach .or. .not. has_free_position(n, cn%elem)) cycle
@@ -95,30 +95,30 @@ contains
         call take(cn)
       end do
     end do
-    if (added > 0) c%changes = c%changes + 1
+    if (added > 0) c%set%changes = c%set%changes + 1
   contains
     !> add cn if its gap is beyond the tolerance (sticking, with friction)
     subroutine take(cn)
       type(constraint_t), intent(inout) :: cn
       if (friction_on(c, cn%pair)) cn%grip = stick
       call constraint_geometry(c, model, x, q, cn, normals)
-      if (c%stick_at_touch .and. cn%grip == stick) then   ! (its slip so far is not stuck)
+      if (c%opt%stick_at_touch .and. cn%grip == stick) then   ! (its slip so far is not stuck)
         cn%u0 = cn%ut
         call constraint_geometry(c, model, x, q, cn, normals)
       end if
-      if (cn%gap < -c%tol) then
+      if (cn%gap < -c%opt%tol) then
         gs = start_gap(cn)
         ! already between the target's faces at the step's start, not held, come in edge-on
         ! (through the rim, past the faces) or sideways: casca has no edge contact, and
         ! pushed out to a face in one step it made energy (a hoop past a plate's corner,
         ! both ways round: 80% of the energy in a step). It is left free.
-        if (c%faces .and. gs < -0.25_dp*cn%off) return
+        if (c%opt%faces .and. gs < -0.25_dp*cn%off) return
         ! inside already: held where it was (between faces; a compliant contact's node is
         ! inside by design, and between mid-surfaces a thin ring's node that came through the
         ! target's one side is taken back, as before: held, one stayed 0.63 mm behind it)
-        if (c%faces .and. gs < -c%tol .and. .not. (c%probe .or. c%compliance(cn%node) > 0)) then
+        if (c%opt%faces .and. gs < -c%opt%tol .and. .not. (c%opt%probe .or. c%opt%compliance(cn%node) > 0)) then
           cn%hold = gs; cn%gap = cn%gap - gs   ! (constraint_geometry's gap, less the depth)
-          if (.not. cn%gap < -c%tol) return   ! (coming out by itself)
+          if (.not. cn%gap < -c%opt%tol) return   ! (coming out by itself)
         end if
         ! in a solve whose set cycles, a node arriving with more slip over the step
         ! than Coulomb's impulse can stop, mu_s times the normal approach (its depth), comes
@@ -126,8 +126,8 @@ contains
         ! onto a floor met stick forces of 900 N against its 1 N weight and tensile
         ! multipliers, and the set did not settle. Not always: a thick hoop's sliding nodes
         ! taken so made 0.065% of its energy in a step, by the friction work's account.)
-        if (cn%grip == stick .and. .not. c%stick_at_touch .and. c%cycling) then
-          if (norm2(cn%ut) > max(c%slip_floor, c%mu_s(cn%pair)*(-cn%gap))) then
+        if (cn%grip == stick .and. .not. c%opt%stick_at_touch .and. c%set%cycling) then
+          if (norm2(cn%ut) > max(c%opt%slip_floor, c%mu_s(cn%pair)*(-cn%gap))) then
             cn%grip = slip; cn%s = cn%ut/norm2(cn%ut); cn%s0 = cn%s
           end if
         end if
@@ -173,8 +173,8 @@ contains
       type(constraint_t), intent(in) :: cn
       integer :: j
       redundant = .false.
-      do j = 1, c%nact
-        associate (o => c%act(j))
+      do j = 1, c%set%nact
+        associate (o => c%set%act(j))
           if (o%elem == 0) cycle
           if (c%pair(1, o%pair) /= c%pair(2, cn%pair) .or. c%pair(2, o%pair) /= c%pair(1, cn%pair)) cycle
           if (any(model%conn(:, cn%elem) == o%node) .and. any(model%conn(:, o%elem) == cn%node)) then
@@ -187,13 +187,13 @@ contains
     subroutine push(con)
       type(constraint_t), intent(in) :: con
       type(constraint_t), allocatable :: tmp(:)
-      if (c%nact == size(c%act)) then
-        allocate (tmp(2*size(c%act)))
-        tmp(1:c%nact) = c%act(1:c%nact)
-        call move_alloc(tmp, c%act)
+      if (c%set%nact == size(c%set%act)) then
+        allocate (tmp(2*size(c%set%act)))
+        tmp(1:c%set%nact) = c%set%act(1:c%set%nact)
+        call move_alloc(tmp, c%set%act)
       end if
-      c%nact = c%nact + 1
-      c%act(c%nact) = con
+      c%set%nact = c%set%nact + 1
+      c%set%act(c%set%nact) = con
     end subroutine push
   end subroutine contact_update
 
@@ -203,8 +203,8 @@ contains
     type(contact_t), intent(inout) :: c
     integer :: k
     real(dp) :: g
-    do k = 1, c%nact
-      associate (a => c%act(k))
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
         if (.not. a%hold < 0) cycle
         g = a%gap + a%hold   ! (the gap itself)
         a%hold = min(0._dp, max(a%hold, g))
@@ -217,12 +217,12 @@ contains
   subroutine contact_solve_start(c)
     type(contact_t), intent(inout) :: c
     integer :: k
-    c%changes = 0
-    c%nseen = 0; c%cycling = .false.
+    c%set%changes = 0
+    c%set%nseen = 0; c%set%cycling = .false.
     c%follow_slip = .false.; c%hold_slip = .false.
-    c%act(1:c%nact)%flips = 0
-    do k = 1, c%nact
-      c%act(k)%s0 = c%act(k)%s
+    c%set%act(1:c%set%nact)%flips = 0
+    do k = 1, c%set%nact
+      c%set%act(k)%s0 = c%set%act(k)%s
     end do
   end subroutine contact_solve_start
 
@@ -246,32 +246,34 @@ contains
     call contact_release(c, released, keep_stuck=.not. stick)
     call contact_update(c, model, q, .true., added, reproject=.false.)
     changed = released + added
-    if (changed > 0) call remember_set(c)
+    if (changed > 0) call remember_set(c%set, c%npairs)
   end subroutine contact_settle
 
   !> Note the set Newton goes on with; one it had already converged for in this solve is a
   !> cycle (a hoop rolling on a floor under friction: three constraints, two of them tensile,
   !> released together; then both penetrating, taken again), broken by releasing one at a
   !> time (contact_release) and letting nodes that arrive sliding come in so (take)
-  subroutine remember_set(c)
-    type(contact_t), intent(inout) :: c
+  subroutine remember_set(set, npairs)
+    type(active_set_t), intent(inout) :: set
+    integer, intent(in) :: npairs
     integer(i8) :: key(2)
-    key = set_key(c)
-    if (any(c%seen(1, 1:c%nseen) == key(1) .and. c%seen(2, 1:c%nseen) == key(2))) c%cycling = .true.
-    if (c%nseen == size(c%seen, 2)) return
-    c%nseen = c%nseen + 1
-    c%seen(:, c%nseen) = key
+    key = set_key(set, npairs)
+    if (any(set%seen(1, 1:set%nseen) == key(1) .and. set%seen(2, 1:set%nseen) == key(2))) set%cycling = .true.
+    if (set%nseen == size(set%seen, 2)) return
+    set%nseen = set%nseen + 1
+    set%seen(:, set%nseen) = key
   end subroutine remember_set
 
   !> Two sums over the active constraints, of the (node, pair) numbers and of their squares:
   !> the same for the same set, whatever its order
-  pure function set_key(c) result(key)
-    type(contact_t), intent(in) :: c
+  pure function set_key(set, npairs) result(key)
+    type(active_set_t), intent(in) :: set
+    integer, intent(in) :: npairs
     integer(i8) :: key(2), m
     integer :: k
     key = 0
-    do k = 1, c%nact
-      m = int(c%act(k)%node, i8)*int(c%npairs + 1, i8) + c%act(k)%pair
+    do k = 1, set%nact
+      m = int(set%act(k)%node, i8)*int(npairs + 1, i8) + set%act(k)%pair
       key = key + [m, m*m]
     end do
   end function set_key
@@ -288,23 +290,23 @@ contains
     integer :: k, m, only
     real(dp) :: most
     only = 0   ! (every tensile one)
-    if (c%cycling) then   ! only the most tensile
+    if (c%set%cycling) then   ! only the most tensile
       most = 0
-      do k = 1, c%nact
-        if (tensile(c%act(k)) .and. c%act(k)%lambda > most) then
-          most = c%act(k)%lambda; only = k
+      do k = 1, c%set%nact
+        if (tensile(c%set%act(k)) .and. c%set%act(k)%lambda > most) then
+          most = c%set%act(k)%lambda; only = k
         end if
       end do
     end if
     m = 0
-    do k = 1, c%nact
-      if (tensile(c%act(k)) .and. (only == 0 .or. k == only)) cycle
+    do k = 1, c%set%nact
+      if (tensile(c%set%act(k)) .and. (only == 0 .or. k == only)) cycle
       m = m + 1
-      c%act(m) = c%act(k)
+      c%set%act(m) = c%set%act(k)
     end do
-    released = c%nact - m
-    c%nact = m
-    if (released > 0) c%changes = c%changes + 1
+    released = c%set%nact - m
+    c%set%nact = m
+    if (released > 0) c%set%changes = c%set%changes + 1
   contains
     logical function tensile(a)
       type(constraint_t), intent(in) :: a

@@ -17,7 +17,8 @@ module casca_contact
   use casca_obstacle, only: obstacle_t
   implicit none
   private
-  public :: contact_t, constraint_t, target_geometry_t, contact_init, face_reach, search_radius
+  public :: contact_t, contact_options_t, active_set_t, constraint_t, target_geometry_t
+  public :: contact_init, face_reach, search_radius
   public :: contact_set_stiffness, normal_compliance, normal_residual, holds, tested_both_ways
   public :: new_constraint, slip_followed
 
@@ -102,49 +103,30 @@ module casca_contact
     real(dp) :: dphi_node(10, 2, 10) = 0
   end type target_geometry_t
 
-  type :: contact_t
-    ! options
+  !> How contact is modelled: fixed for the run by the deck and the time scheme.
+  type :: contact_options_t
     real(dp) :: tol = 0                         !< penetration accepted [m]
     logical :: nodal_normal = .true.            !< n from nodal normals, else the element's
     logical :: faces = .true.                   !< contact at the shell faces, else mid-surfaces
-    !> per node: on its shell's free edge (the rim), the only place a node can touch edge-on
-    logical, allocatable :: rim(:)
     !> per node: its normal constraint's compliance, penetration per unit force [m/N]
     !> (contact_set_stiffness); 0 everywhere: hard contact, no penetration (the thesis)
     real(dp), allocatable :: compliance(:)
     logical :: compliant = .false.              !< some compliance is not 0
     real(dp) :: alpha_f = 0                     !< the time scheme's: where a compliant force is taken
-    ! the problem
-    integer :: npairs = 0
-    integer, allocatable :: pair(:, :)          !< (2, npairs) impactor body, target: a body,
-                                                !< or -k for obstacle k
-    type(obstacle_t), allocatable :: obstacle(:)
-    real(dp) :: time = 0                        !< obstacles are where they are at this time
-    ! Coulomb friction per pair: dynamic and static coefficients; the step's start positions
-    ! and length (friction needs them: without them contact is frictionless)
-    real(dp), allocatable :: mu_d(:), mu_s(:)
-    real(dp), allocatable :: x_start(:, :), g_start(:, :)   !< positions and fibres
-    real(dp) :: dt = 0
     !> a slip over the step shorter than this [m] does not turn s: its direction is Newton's
     !> round-off (tol = 1e-10 of the scene size), and the sliding force's stiffness across it,
     !> mu_d |lambda| / |ut|, would turn the rows hard (a trial without this floor met slips of
     !> 1e-19 m at slip onset, and singular Schur complements)
     real(dp) :: slip_floor = 0
-    !> sliding directions follow the slip at this iterate (Newton sets it once an iterate is
-    !> near); else each holds its last. hold_slip: not in this solve (friction_hold)
-    logical :: follow_slip = .false., hold_slip = .false.
     !> statics: a contact made in a load increment sticks where it touched, not where its node
     !> was at the increment's start (a cantilever's tip slides a long way before it touches)
     logical :: stick_at_touch = .false.
     !> a probe (probes.f90): measures penetrations, holds none
     logical :: probe = .false.
-    real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
-    real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
-    ! per pair: the impulse on the impactor so far, as the integrator applied it, and the
-    ! contact's share of M a at the start of the next step [N s, N]
-    real(dp), allocatable :: impulse(:, :), carry(:, :)
-    type(target_geometry_t) :: geo
-    ! the active set
+  end type contact_options_t
+
+  !> The constraints holding now, and what the solve has learnt of them (active_set.f90).
+  type :: active_set_t
     integer :: nact = 0
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
@@ -154,6 +136,36 @@ module casca_contact
     integer(i8) :: seen(2, 16) = 0
     integer :: nseen = 0
     logical :: cycling = .false.
+  end type active_set_t
+
+  !> A contact problem: its options, pairs and obstacles, the targets' geometry, the active
+  !> set, the step's start that friction measures slip from, and the accounts per pair.
+  type :: contact_t
+    type(contact_options_t) :: opt
+    ! the problem
+    integer :: npairs = 0
+    integer, allocatable :: pair(:, :)          !< (2, npairs) impactor body, target: a body,
+                                                !< or -k for obstacle k
+    type(obstacle_t), allocatable :: obstacle(:)
+    real(dp) :: time = 0                        !< obstacles are where they are at this time
+    !> per node: on its shell's free edge (the rim), the only place a node can touch edge-on
+    logical, allocatable :: rim(:)
+    real(dp), allocatable :: mu_d(:), mu_s(:)   !< Coulomb friction per pair: dynamic, static
+    type(target_geometry_t) :: geo
+    type(active_set_t) :: set
+    ! the step: its start positions and fibres and its length (friction needs them: without
+    ! them contact is frictionless)
+    real(dp), allocatable :: x_start(:, :), g_start(:, :)
+    real(dp) :: dt = 0
+    !> sliding directions follow the slip at this iterate (Newton sets it once an iterate is
+    !> near); else each holds its last. hold_slip: not in this solve (friction_hold)
+    logical :: follow_slip = .false., hold_slip = .false.
+    ! accounts
+    real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
+    real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
+    ! per pair: the impulse on the impactor so far, as the integrator applied it, and the
+    ! contact's share of M a at the start of the next step [N s, N]
+    real(dp), allocatable :: impulse(:, :), carry(:, :)
   end type contact_t
 
 contains
@@ -180,11 +192,11 @@ contains
     type(surface_t) :: own
     c%npairs = size(pairs, 2)
     c%pair = pairs
-    allocate (c%compliance(model%nnode))
-    c%compliance = 0
+    allocate (c%opt%compliance(model%nnode))
+    c%opt%compliance = 0
     c%obstacle = obstacles
-    c%tol = tol
-    c%faces = faces
+    c%opt%tol = tol
+    c%opt%faces = faces
     allocate (c%rim(model%nnode))
     c%rim = .false.
     do b = 1, model%nbody
@@ -196,9 +208,9 @@ contains
         end do
       end associate
     end do
-    allocate (c%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
+    allocate (c%set%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
     c%mu_d = 0; c%mu_s = 0; c%friction_work = 0
-    c%slip_floor = slip_share*model%length
+    c%opt%slip_floor = slip_share*model%length
     allocate (c%impulse(3, c%npairs), c%carry(3, c%npairs))
     c%impulse = 0; c%carry = 0
     associate (g => c%geo)
@@ -280,8 +292,8 @@ contains
         end do
       end associate
     end do
-    c%compliance = 1/(stiffness*max(area, tiny(1._dp)))
-    c%compliant = .true.
+    c%opt%compliance = 1/(stiffness*max(area, tiny(1._dp)))
+    c%opt%compliant = .true.
   end subroutine contact_set_stiffness
 
   !> Whether sliding constraint a's direction s follows its slip ut at this iterate: the slip
@@ -293,14 +305,14 @@ contains
     type(constraint_t), intent(in) :: a
     slip_followed = .false.
     if (c%follow_slip .and. a%grip == slip) &
-      slip_followed = norm2(a%ut) >= c%slip_floor .and. norm2(a%ut) > 0 .and. dot_product(a%ut, a%s0) > 0
+      slip_followed = norm2(a%ut) >= c%opt%slip_floor .and. norm2(a%ut) > 0 .and. dot_product(a%ut, a%s0) > 0
   end function slip_followed
 
   !> Whether the active set holds a constraint of node on pair p
-  pure logical function holds(c, node, p)
-    type(contact_t), intent(in) :: c
+  pure logical function holds(set, node, p)
+    type(active_set_t), intent(in) :: set
     integer, intent(in) :: node, p
-    holds = any(c%act(1:c%nact)%node == node .and. c%act(1:c%nact)%pair == p)
+    holds = any(set%act(1:set%nact)%node == node .and. set%act(1:set%nact)%pair == p)
   end function holds
 
   !> The compliance of constraint a's normal row as the row carries it [m/N] (0: hard). The
@@ -313,7 +325,7 @@ contains
   pure real(dp) function normal_compliance(c, a)
     type(contact_t), intent(in) :: c
     type(constraint_t), intent(in) :: a
-    normal_compliance = c%compliance(a%node)/(1 - c%alpha_f)
+    normal_compliance = c%opt%compliance(a%node)/(1 - c%opt%alpha_f)
   end function normal_compliance
 
   !> The residual of constraint a's normal row (its gap, for a hard contact)
@@ -321,7 +333,7 @@ contains
     type(contact_t), intent(in) :: c
     type(constraint_t), intent(in) :: a
     normal_residual = a%gap
-    if (c%compliance(a%node) > 0) normal_residual = a%gap + c%alpha_f/(1 - c%alpha_f)*a%g0 - &
+    if (c%opt%compliance(a%node) > 0) normal_residual = a%gap + c%opt%alpha_f/(1 - c%opt%alpha_f)*a%g0 - &
                                                     normal_compliance(c, a)*a%lambda
   end function normal_residual
 
@@ -333,7 +345,7 @@ contains
     type(model_t), intent(in) :: model
     integer, intent(in) :: bi, bt
     face_reach = 0
-    if (.not. c%faces) return
+    if (.not. c%opt%faces) return
     face_reach = 0.5_dp*model%body(bi)%thickness
     if (bt > 0) face_reach = face_reach + 0.5_dp*model%body(bt)%thickness
     face_reach = 1.25_dp*face_reach
@@ -356,7 +368,7 @@ contains
     if (bt > 0) then
       search_radius = face_reach(c, model, bi, bt) + c%geo%depth(bt)
     else
-      search_radius = face_reach(c, model, bi, bt) + c%tol
+      search_radius = face_reach(c, model, bi, bt) + c%opt%tol
     end if
   end function search_radius
 end module casca_contact

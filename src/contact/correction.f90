@@ -73,10 +73,10 @@ contains
     integer :: nc, r, info
     integer, allocatable :: rk(:), rkind(:)
     logical :: same
-    if (c%nact == 0) return
-    call row_list(c%act(1:c%nact), rk, rkind)
+    if (c%set%nact == 0) return
+    call row_list(c%set%act(1:c%set%nact), rk, rkind)
     nc = size(rk)
-    call build_rows(c%act(1:c%nact), rk, rkind, model, rows)
+    call build_rows(c%set%act(1:c%set%nact), rk, rkind, model, rows)
     allocate (nu(nc, 2))
     ! (against a moving obstacle the node keeps the obstacle's speed)
     nu(:, 1) = -[(row_dot(rows, r, v) - obstacle_rate(r), r=1, nc)]
@@ -104,9 +104,9 @@ contains
     if (present(impulse)) impulse = nu(:, 1)
     do r = 1, nc
       if (rkind(r) == 0) then
-        c%act(rk(r))%mu = nu(r, 2)
+        c%set%act(rk(r))%mu = nu(r, 2)
       else
-        c%act(rk(r))%mut(rkind(r)) = nu(r, 2)
+        c%set%act(rk(r))%mut(rkind(r)) = nu(r, 2)
       end if
     end do
     dva = images(ms, cache%x, cache%rows%dir, nu, size(v))   ! v += M^-1 C^T nu_v, a likewise
@@ -117,7 +117,7 @@ contains
     real(dp) function obstacle_rate(r)
       integer, intent(in) :: r
       integer :: t
-      t = c%pair(2, c%act(rk(r))%pair)
+      t = c%pair(2, c%set%act(rk(r))%pair)
       obstacle_rate = 0
       if (t > 0) return
       obstacle_rate = dot_product(rows%dir(:, r), c%obstacle(-t)%velocity)

@@ -47,8 +47,8 @@ contains
     integer :: k
     real(dp) :: f(3)
     changed = 0
-    do k = 1, c%nact
-      associate (a => c%act(k))
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
         select case (a%grip)
         case (stick)
           f = a%lt(1)*a%t(:, 1) + a%lt(2)*a%t(:, 2)   ! minus the stick force on the node
@@ -64,7 +64,7 @@ contains
         end select
       end associate
     end do
-    if (changed > 0) c%changes = c%changes + 1
+    if (changed > 0) c%set%changes = c%set%changes + 1
   end subroutine friction_update
 
   !> The sliding directions are held for the rest of the solve, each at its solve's start
@@ -75,8 +75,8 @@ contains
     type(contact_t), intent(inout) :: c
     integer :: k
     c%follow_slip = .false.; c%hold_slip = .true.
-    do k = 1, c%nact
-      if (c%act(k)%grip == slip) c%act(k)%s = c%act(k)%s0
+    do k = 1, c%set%nact
+      if (c%set%act(k)%grip == slip) c%set%act(k)%s = c%set%act(k)%s0
     end do
   end subroutine friction_hold
 
@@ -99,12 +99,12 @@ contains
     ! hands its contact from node to node): along its slip of the step before
     do k = 1, size(before)
       associate (b => before(k))
-        if (b%grip /= slip .or. holds(c, b%node, b%pair)) cycle
+        if (b%grip /= slip .or. holds(c%set, b%node, b%pair)) cycle
         c%friction_work(b%pair) = c%friction_work(b%pair) - dot_product((1 - w)*b%fa, b%ut)
       end associate
     end do
-    do k = 1, c%nact
-      associate (a => c%act(k))
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
         f = friction_force(c, a)
         if (a%grip == slip) then
           c%friction_work(a%pair) = c%friction_work(a%pair) - dot_product((1 - w)*a%fa + w*f, a%ut)
@@ -122,8 +122,8 @@ contains
     real(dp) :: ft(c%npairs), f(3, c%npairs)
     integer :: k
     f = 0
-    do k = 1, c%nact
-      f(:, c%act(k)%pair) = f(:, c%act(k)%pair) + c%act(k)%fa
+    do k = 1, c%set%nact
+      f(:, c%set%act(k)%pair) = f(:, c%set%act(k)%pair) + c%set%act(k)%fa
     end do
     ft = norm2(f, dim=1)
   end function pair_tangential_force

@@ -20,8 +20,8 @@ contains
     real(dp) :: fn(c%npairs)
     integer :: k
     fn = 0
-    do k = 1, c%nact
-      fn(c%act(k)%pair) = fn(c%act(k)%pair) - c%act(k)%lambda
+    do k = 1, c%set%nact
+      fn(c%set%act(k)%pair) = fn(c%set%act(k)%pair) - c%set%act(k)%lambda
     end do
   end function pair_normal_force
 
@@ -31,8 +31,8 @@ contains
     integer :: n(c%npairs)
     integer :: k
     n = 0
-    do k = 1, c%nact
-      n(c%act(k)%pair) = n(c%act(k)%pair) + 1
+    do k = 1, c%set%nact
+      n(c%set%act(k)%pair) = n(c%set%act(k)%pair) + 1
     end do
   end function pair_active_count
 

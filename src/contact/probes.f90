@@ -24,13 +24,13 @@ contains
     call new_probe(c, 0._dp, probe)
     call contact_update(probe, model, q, .true., added, .false.)
     free_pen = 0
-    do k = 1, probe%nact
-      if (holds(c, probe%act(k)%node, probe%act(k)%pair)) cycle
-      free_pen = max(free_pen, -probe%act(k)%gap)
+    do k = 1, probe%set%nact
+      if (holds(c%set, probe%set%act(k)%node, probe%set%act(k)%pair)) cycle
+      free_pen = max(free_pen, -probe%set%act(k)%gap)
     end do
-    if (c%nact > 0) free_pen = max(free_pen, -minval(c%act(1:c%nact)%hold))   ! (held, not pushed out)
+    if (c%set%nact > 0) free_pen = max(free_pen, -minval(c%set%act(1:c%set%nact)%hold))   ! (held, not pushed out)
     max_gap = 0
-    if (c%nact > 0) max_gap = maxval(abs(c%act(1:c%nact)%gap))
+    if (c%set%nact > 0) max_gap = maxval(abs(c%set%act(1:c%set%nact)%gap))
   end subroutine contact_penetration
 
   !> Gap of every impactor node to its target between the surfaces in contact (faces or
@@ -50,8 +50,8 @@ contains
     ! every node within reach, penetrating or not: a probe that takes any gap
     call new_probe(c, -huge(1._dp), probe)
     call contact_update(probe, model, q, .true., added, .false.)
-    do k = 1, probe%nact
-      sd(probe%act(k)%node) = min(sd(probe%act(k)%node), probe%act(k)%gap)
+    do k = 1, probe%set%nact
+      sd(probe%set%act(k)%node) = min(sd(probe%set%act(k)%node), probe%set%act(k)%gap)
     end do
   end subroutine contact_signed_distance
 
@@ -61,10 +61,10 @@ contains
     real(dp), intent(in) :: tol
     type(contact_t), intent(out) :: probe
     probe = c
-    probe%nact = 0
-    probe%changes = 0
+    probe%set%nact = 0
+    probe%set%changes = 0
     probe%geo%grid_ok = .false.
-    probe%tol = tol
-    probe%probe = .true.
+    probe%opt%tol = tol
+    probe%opt%probe = .true.
   end subroutine new_probe
 end module casca_contact_probes

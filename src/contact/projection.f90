@@ -122,7 +122,7 @@ contains
         if (rim .and. tested_both_ways(c, bi, bt)) then
           ok = .false.
           return
-        else if (rim .and. c%faces) then
+        else if (rim .and. c%opt%faces) then
           con%side = around_rim; con%sd = dist
         else if (abs(dot_product(x(:, node) - xq, nt)) < 0.5_dp*dist*norm2(nt)) then
           ok = .false.
@@ -177,7 +177,7 @@ contains
     if (bt <= 0) then
       con%elem = 0; con%side = 1; con%shp = 0
       call obstacle_point(c%obstacle(-bt), c%time, x(:, con%node), con%n, gm)
-      if (c%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
+      if (c%opt%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
                              -con%n, con%face(1), con%off, con%wg(1), c%rim(con%node))
       con%gap = gm - con%off - con%hold
       call hold_force_point(con)
@@ -190,7 +190,7 @@ contains
     rim = con%side == around_rim
     if (rim) then
       call rim_normal(xe, dphi, con%xi, x(:, con%node) - xt, con%n, te, tw, tl)
-    else if (c%nodal_normal) then
+    else if (c%opt%nodal_normal) then
       con%n = 0
       do j = 1, 10
         call node_normal_sum(c, model, x, con%elem, j, m, normals)
@@ -205,10 +205,10 @@ contains
     ! faces a shell is two-sided and the node stays on the side it came from
     if (con%side == 0) then
       con%side = 1
-      if (c%faces) con%side = int(sign(1._dp, gm))
+      if (c%opt%faces) con%side = int(sign(1._dp, gm))
     end if
     if (.not. rim) con%n = con%side*con%n
-    if (c%faces) then
+    if (c%opt%faces) then
       gt = 0
       do j = 1, 10
         nd = model%conn(j, con%elem)
@@ -536,7 +536,7 @@ contains
     nl = 0; ne = 0; iv = 0
     call tri10_shape(con%xi(1), con%xi(2), shp, dphi)
     associate (g => c%geo)
-      if (.not. c%nodal_normal) then
+      if (.not. c%opt%nodal_normal) then
         call back_normal(con%elem, dphi, con%side*dv, 1._dp)
       else
         u = 0

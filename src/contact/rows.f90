@@ -32,14 +32,14 @@ contains
   pure integer function contact_nrows(c)
     type(contact_t), intent(in) :: c
     integer :: k
-    contact_nrows = sum([(constraint_nkinds(c%act(k)), k=1, c%nact)])
+    contact_nrows = sum([(constraint_nkinds(c%set%act(k)), k=1, c%set%nact)])
   end function contact_nrows
 
   !> Number of rows of Newton's system: the active set's, and one across the slip of each
   !> sliding constraint (contact_rows)
   pure integer function contact_newton_nrows(c)
     type(contact_t), intent(in) :: c
-    contact_newton_nrows = contact_nrows(c) + count(c%act(1:c%nact)%grip == slip)
+    contact_newton_nrows = contact_nrows(c) + count(c%set%act(1:c%set%nact)%grip == slip)
   end function contact_newton_nrows
 
   !> Every active constraint's force point (force_point) where the scheme takes the
@@ -63,30 +63,30 @@ contains
     else
       qf = q
     end if
-    do k = 1, c%nact
-      call force_point(model, qf, c%act(k))
-      bt = c%pair(2, c%act(k)%pair)
+    do k = 1, c%set%nact
+      call force_point(model, qf, c%set%act(k))
+      bt = c%pair(2, c%set%act(k)%pair)
       if (bt > 0) then
-        if (c%act(k)%nl == 0) cycle
+        if (c%set%act(k)%nl == 0) cycle
         ! a normal row with its lever: the gap's gradient at qf (its point, side and faces
         ! held), the midpoint rule's force for a work that is the gap's change over the step
         if (.not. allocated(xf)) then
           xf = positions(model, qf)
-          if (c%nodal_normal) call normal_cache(model, normals)
+          if (c%opt%nodal_normal) call normal_cache(model, normals)
         end if
-        cf = c%act(k)   ! (normals: made and read with nodal normals only)
+        cf = c%set%act(k)   ! (normals: made and read with nodal normals only)
         call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
-        if (cf%nl /= c%act(k)%nl) cycle   ! (the same nodes; else the end's gradient)
-        c%act(k)%nf = cf%n; c%act(k)%wgf = cf%wg; c%act(k)%lgradf = cf%lgrad(:, 1:cf%nl)
+        if (cf%nl /= c%set%act(k)%nl) cycle   ! (the same nodes; else the end's gradient)
+        c%set%act(k)%nf = cf%n; c%set%act(k)%wgf = cf%wg; c%set%act(k)%lgradf = cf%lgrad(:, 1:cf%nl)
         cycle
       end if
       ! an obstacle: its normal at the node's face point there (the midpoint rule's
       ! angular momentum about a cylinder's axis changes by x_mid x f, which n at the step's
       ! end, half a step's slide away, did not leave at zero: a ring spinning in a drum lost
       ! 1.4e-4 of it at 10 us, first order in dt)
-      nd = c%act(k)%node
+      nd = c%set%act(k)%node
       call obstacle_point(c%obstacle(-bt), c%time, qf(dof(nd, 1):dof(nd, 3)) + &
-                          c%act(k)%wg(1)*qf(dof(nd, 4):dof(nd, 6)), c%act(k)%nf, gm)
+                          c%set%act(k)%wg(1)*qf(dof(nd, 4):dof(nd, 6)), c%set%act(k)%nf, gm)
     end do
   end subroutine contact_force_points
 
@@ -98,11 +98,11 @@ contains
     integer :: k, r
     allocate (lam(contact_newton_nrows(c)))
     r = 0
-    do k = 1, c%nact
-      r = r + 1; lam(r) = c%act(k)%lambda
-      if (c%act(k)%grip == stick) then
-        lam(r + 1:r + 2) = c%act(k)%lt; r = r + 2
-      else if (c%act(k)%grip == slip) then
+    do k = 1, c%set%nact
+      r = r + 1; lam(r) = c%set%act(k)%lambda
+      if (c%set%act(k)%grip == stick) then
+        lam(r + 1:r + 2) = c%set%act(k)%lt; r = r + 2
+      else if (c%set%act(k)%grip == slip) then
         r = r + 1; lam(r) = 0
       end if
     end do
@@ -113,11 +113,11 @@ contains
     real(dp), intent(in) :: lam(:)
     integer :: k, r
     r = 0
-    do k = 1, c%nact
-      r = r + 1; c%act(k)%lambda = lam(r)
-      if (c%act(k)%grip == stick) then
-        c%act(k)%lt = lam(r + 1:r + 2); r = r + 2
-      else if (c%act(k)%grip == slip) then
+    do k = 1, c%set%nact
+      r = r + 1; c%set%act(k)%lambda = lam(r)
+      if (c%set%act(k)%grip == stick) then
+        c%set%act(k)%lt = lam(r + 1:r + 2); r = r + 2
+      else if (c%set%act(k)%grip == slip) then
         r = r + 1
       end if
     end do
@@ -148,36 +148,37 @@ contains
     nr = contact_newton_nrows(c)
     ! (entries: 66 for the points and fibres and a diagonal per row, one more row across a
     ! slip, the levers' beside)
-    m = sum([(67*(constraint_nkinds(c%act(k)) + merge(1, 0, c%act(k)%grip == slip)) + 3*c%act(k)%nl, &
-              k=1, c%nact)])
+    m = sum([(67*(constraint_nkinds(c%set%act(k)) + merge(1, 0, c%set%act(k)%grip == slip)) + 3*c%set%act(k)%nl, &
+              k=1, c%set%nact)])
     allocate (irn(m), jcn(m), val(m), gap(nr), key(2, nr), fval(m))
     m = 0; r = 0
-    do k = 1, c%nact
-      do i = 0, constraint_nkinds(c%act(k)) - merge(0, 1, c%act(k)%grip == slip)
+    do k = 1, c%set%nact
+      do i = 0, constraint_nkinds(c%set%act(k)) - merge(0, 1, c%set%act(k)%grip == slip)
         kind = i
-        if (c%act(k)%grip == slip .and. i == 1) kind = across
+        if (c%set%act(k)%grip == slip .and. i == 1) kind = across
         r = r + 1
         if (kind == 0) then   ! (compliant: g - lambda / k, contact_set_stiffness)
-          gap(r) = normal_residual(c, c%act(k))
+          gap(r) = normal_residual(c, c%set%act(k))
         else if (kind == across) then
           gap(r) = 0
         else
-          gap(r) = c%act(k)%gt(kind)
+          gap(r) = c%set%act(k)%gt(kind)
         end if
-        key(:, r) = [4*c%act(k)%node + kind, c%act(k)%elem]
-        if (kind == across) key(1, r) = -(4*c%act(k)%node + 3)   ! (apart from every other row)
-        call constraint_row(c%act(k), model, d, v, nd, kind)
+        key(:, r) = [4*c%set%act(k)%node + kind, c%set%act(k)%elem]
+        if (kind == across) key(1, r) = -(4*c%set%act(k)%node + 3)   ! (apart from every other row)
+        call constraint_row(c%set%act(k), model, d, v, nd, kind)
         vf(1:nd) = v(1:nd)   ! (the force's own row only where it has its own point)
-        if (any(c%act(k)%shpf /= c%act(k)%shp) .or. any(c%act(k)%nf /= c%act(k)%n) .or. c%act(k)%nl > 0) &
-          call constraint_row(c%act(k), model, d, vf, nd, kind, force=.true.)
+        if (any(c%set%act(k)%shpf /= c%set%act(k)%shp) .or. any(c%set%act(k)%nf /= c%set%act(k)%n) .or. &
+            c%set%act(k)%nl > 0) &
+          call constraint_row(c%set%act(k), model, d, vf, nd, kind, force=.true.)
         mu = 0; ns = 0
-        if (kind == 0 .and. c%act(k)%grip == slip .and. c%act(k)%lambda < 0) then
-          mu = c%mu_d(c%act(k)%pair); key(1, r) = 4*c%act(k)%node + 3
-          call constraint_row(c%act(k), model, d, vs, ns, 3, force=.true.)   ! (the same points first)
+        if (kind == 0 .and. c%set%act(k)%grip == slip .and. c%set%act(k)%lambda < 0) then
+          mu = c%mu_d(c%set%act(k)%pair); key(1, r) = 4*c%set%act(k)%node + 3
+          call constraint_row(c%set%act(k), model, d, vs, ns, 3, force=.true.)   ! (the same points first)
         end if
         w = 1   ! (the row's weight: 0 for an empty row across a held s)
         if (kind == across) then
-          ks = slip_stiffness(c, c%act(k))
+          ks = slip_stiffness(c, c%set%act(k))
           if (.not. ks > 0) w = 0
         end if
         do j = 1, nd
@@ -186,7 +187,7 @@ contains
           if (j <= ns) fval(m) = vf(j) - mu*vs(j)
         end do
         m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
-        if (kind == 0) val(m) = -normal_compliance(c, c%act(k))
+        if (kind == 0) val(m) = -normal_compliance(c, c%set%act(k))
         if (kind == across) then
           val(m) = -1
           if (w > 0) val(m) = -1/ks
@@ -222,8 +223,8 @@ contains
     integer :: k, nd, d(max_row)
     real(dp) :: v(max_row)
     f = 0
-    do k = 1, c%nact
-      associate (a => c%act(k))
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
         call constraint_row(a, model, d, v, nd, force=.true.)
         f(d(1:nd)) = f(d(1:nd)) + a%lambda*v(1:nd)
         if (a%grip == stick) then
@@ -242,7 +243,7 @@ contains
   !> Total normal contact force (sum of the compressive multipliers).
   pure real(dp) function contact_force_total(c)
     type(contact_t), intent(in) :: c
-    contact_force_total = -sum(c%act(1:c%nact)%lambda)
+    contact_force_total = -sum(c%set%act(1:c%set%nact)%lambda)
   end function contact_force_total
 
   !> Largest residual of the active rows: |gap| (less compliance times lambda) and the stick
@@ -251,9 +252,9 @@ contains
     type(contact_t), intent(in) :: c
     integer :: k
     contact_max_gap = 0
-    do k = 1, c%nact
-      contact_max_gap = max(contact_max_gap, abs(normal_residual(c, c%act(k))))
-      if (c%act(k)%grip == stick) contact_max_gap = max(contact_max_gap, maxval(abs(c%act(k)%gt)))
+    do k = 1, c%set%nact
+      contact_max_gap = max(contact_max_gap, abs(normal_residual(c, c%set%act(k))))
+      if (c%set%act(k)%grip == stick) contact_max_gap = max(contact_max_gap, maxval(abs(c%set%act(k)%gt)))
     end do
   end function contact_max_gap
 
@@ -263,10 +264,10 @@ contains
     type(contact_t), intent(in) :: c
     integer :: k
     contact_stored_energy = 0
-    do k = 1, c%nact
-      associate (a => c%act(k))
-        if (c%compliance(a%node) > 0) contact_stored_energy = contact_stored_energy + &
-                                                              0.5_dp*min(a%gap, 0._dp)**2/c%compliance(a%node)
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
+        if (c%opt%compliance(a%node) > 0) contact_stored_energy = contact_stored_energy + &
+                                                              0.5_dp*min(a%gap, 0._dp)**2/c%opt%compliance(a%node)
       end associate
     end do
   end function contact_stored_energy
@@ -277,8 +278,8 @@ contains
     real(dp) :: f(3, c%npairs)
     integer :: k
     f = 0
-    do k = 1, c%nact
-      f(:, c%act(k)%pair) = f(:, c%act(k)%pair) + node_force(c, c%act(k))
+    do k = 1, c%set%nact
+      f(:, c%set%act(k)%pair) = f(:, c%set%act(k)%pair) + node_force(c, c%set%act(k))
     end do
   end function pair_forces
 
@@ -308,8 +309,8 @@ contains
     end do
     j = 0; mu = 0
     r = 0
-    do k = 1, c%nact
-      associate (a => c%act(k))
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
         j(:, a%pair) = j(:, a%pair) + nu(r + 1)*point_normal(a)
         mu(:, a%pair) = mu(:, a%pair) + a%mu*point_normal(a)
         if (a%grip == stick) then
@@ -428,8 +429,8 @@ contains
     integer :: k, j, nodes(11), nn
     real(dp) :: w(11), f(3)
     force = 0
-    do k = 1, c%nact
-      associate (a => c%act(k))
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
         f = node_force(c, a)
         call constraint_entries(a, model, nodes, w, nn, force=.true.)
         do j = 1, nn

@@ -110,7 +110,7 @@ contains
               if (best_tri == 0) cycle
               u = x(:, n) - best_q
               if (norm2(u) > 0) u = u/norm2(u)
-              rounded = c%faces .and. rounded_rim .and. on_rim(s, best_tri, best_region)
+              rounded = c%opt%faces .and. rounded_rim .and. on_rim(s, best_tri, best_region)
               if (rounded) then
                 ft = 0.5_dp*model%body(bt)%thickness
               else
@@ -176,7 +176,7 @@ contains
     found = .false.
     t = tmax
     grow = 0
-    if (c%faces) grow = 0.5_dp*(model%body(bi)%thickness + model%body(bt)%thickness)
+    if (c%opt%faces) grow = 0.5_dp*(model%body(bi)%thickness + model%body(bt)%thickness)
     do it = 1, s%ntri
       w = vn - vm(:, it)
       if (.not. path_meets_box(x(:, n), w, t, lo(:, it) - grow, hi(:, it) + grow)) cycle
@@ -239,7 +239,7 @@ contains
     integer :: s
     real(dp) :: w
     face_along = 0
-    if (.not. c%faces) return
+    if (.not. c%opt%faces) return
     s = 0
     call face(model%body(b)%thickness, gf, u, s, face_along, w)
   end function face_along
@@ -299,7 +299,7 @@ contains
         tname, ''''//kind, ': gap ', pg(ip)%gap, ' m, closing speed ', pg(ip)%speed, &
         ' m/s, time to contact ', trim(adjustl(when))
     end do
-    if (c%faces) then
+    if (c%opt%faces) then
       lines(size(pg) + 1) = '(gaps between the shell faces, half of each thickness from the '// &
         'mid-surfaces; to the target''s sub-triangles: exact at its nodes, chords between them; '// &
         'times at the initial velocities, without deformation or gravity)'

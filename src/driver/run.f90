@@ -146,14 +146,14 @@ contains
       call reference_state(model, q)
       call contact_update(probe, model, q, .true., added)
       if (added == 0) return
-      worst = minloc(probe%act(1:probe%nact)%gap, dim=1)
-      k = probe%act(worst)%node
+      worst = minloc(probe%set%act(1:probe%set%nact)%gap, dim=1)
+      k = probe%set%act(worst)%node
       write (msg, '(a,a,a,a,a,i0,a,es10.3,a)') 'bodies ''', &
         trim(model%body(model%node_body(k))%name), ''' and ''', &
-        trim(target_name(probe%pair(2, probe%act(worst)%pair))), ''' overlap at the start: node ', &
-        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%act(worst)%gap, ' m inside ('
+        trim(target_name(probe%pair(2, probe%set%act(worst)%pair))), ''' overlap at the start: node ', &
+        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%set%act(worst)%gap, ' m inside ('
       msg = trim(msg)//count_of(added, 'node', 'nodes')//' in all); move them apart'
-      if (probe%faces) msg = trim(msg)//' (contact is between the shell faces: half of each '// &
+      if (probe%opt%faces) msg = trim(msg)//' (contact is between the shell faces: half of each '// &
                              'thickness from the mid-surface)'
       call add_problem(deck, 0, trim(msg))
     end subroutine check_overlap
@@ -364,7 +364,7 @@ contains
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
         nact0 = 0
-        if (allocated(contact_before)) nact0 = contact_before%nact
+        if (allocated(contact_before)) nact0 = contact_before%set%nact
         call watch_energy(r, rest, nact0)
         call watch_thickness(r)
         if (.not. step_written(r, interval, next_frame, next_ckpt)) return
@@ -400,7 +400,7 @@ contains
     !> a contact active at the step's start or end (its energy has the cut above instead)
     logical function in_contact()
       in_contact = .false.
-      if (allocated(r%contact)) in_contact = r%contact%nact > 0 .or. contact_before%nact > 0
+      if (allocated(r%contact)) in_contact = r%contact%set%nact > 0 .or. contact_before%set%nact > 0
     end function in_contact
 
     !> what the bodies hold (kinetic and strain energy) or the loads did, before or after
@@ -619,7 +619,7 @@ contains
     allocate (skip(r%model%nnode))
     skip = .false.
     if (allocated(r%contact)) then
-      if (.not. r%contact%compliant) call touching(r%contact)
+      if (.not. r%contact%opt%compliant) call touching(r%contact)
     end if
     err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd, skip)
     ratio = next_step_ratio(r%sc, err)
@@ -644,9 +644,9 @@ contains
     subroutine touching(c)
       type(contact_t), intent(in) :: c
       integer :: k
-      do k = 1, c%nact
-        skip(c%act(k)%node) = .true.
-        if (c%act(k)%elem > 0) skip(r%model%conn(:, c%act(k)%elem)) = .true.
+      do k = 1, c%set%nact
+        skip(c%set%act(k)%node) = .true.
+        if (c%set%act(k)%elem > 0) skip(r%model%conn(:, c%set%act(k)%elem)) = .true.
       end do
     end subroutine touching
   end function step_accepted
@@ -836,8 +836,8 @@ contains
     if (allocated(r%contact)) then
       associate (c => r%contact)
         call contact_penetration(c, r%model, r%st%q, pen, gmax)
-        if (c%nact > 0) lmax = maxval(c%act(1:c%nact)%lambda)
-        call output_history(r%out, r%st, r%bal, c%nact, contact_force_total(c), newton, &
+        if (c%set%nact > 0) lmax = maxval(c%set%act(1:c%set%nact)%lambda)
+        call output_history(r%out, r%st, r%bal, c%set%nact, contact_force_total(c), newton, &
                             max(pen, 0._dp), r%rep%neg_pivots, lmax, gmax, &
                             pair_normal_force(c), pair_active_count(c), norm2(c%impulse, dim=1), r%err, &
                             pair_tangential_force(c), sum(c%friction_work), c%obstacle_work)
@@ -888,7 +888,7 @@ contains
       now = wall_time()
       rate = (now - last%wall)/max(st%t - last%t, tiny(1._dp))
       nc = 0
-      if (allocated(r%contact)) nc = r%contact%nact
+      if (allocated(r%contact)) nc = r%contact%set%nact
       print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
         '  dt', r%nm%dt, '  newton/step', real(r%total_newton - last%newton)/max(st%step - last%step, 1), &
         '  contacts', nc, '  elapsed', now - r%t0, ' s  left', rate*max(r%deck%run%t_end - st%t, 0._dp), ' s'
@@ -998,7 +998,7 @@ contains
     if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t; r%dt_made = r%nm%dt
       r%made_contacts = 0   ! (those of a step that released them acted in it too)
-      if (allocated(r%contact)) r%made_contacts = r%contact%nact
+      if (allocated(r%contact)) r%made_contacts = r%contact%set%nact
       if (present(nact_start)) r%made_contacts = max(r%made_contacts, nact_start)
     end if
     r%rest_last = rest
@@ -1109,7 +1109,7 @@ contains
               'energy a step makes while no contact is active'
       end if
     else if (allocated(r%contact)) then
-      if (r%contact%compliant) then   ! (a spring whose steps are too long for it)
+      if (r%contact%opt%compliant) then   ! (a spring whose steps are too long for it)
         tc = contact_time(r%deck, r%model, b)
         why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &
               rtoa(tc/r%dt_made)//' steps of that step ('//rtoa(r%dt_made)//' s) for body '''// &
@@ -1133,7 +1133,7 @@ contains
     if (moving_obstacles(deck, .true.)) &
       terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work, &
                                                           source=.true.)]
-    if (contact%compliant) terms = [terms, energy_term_t('held in the contact stiffness', &
+    if (contact%opt%compliant) terms = [terms, energy_term_t('held in the contact stiffness', &
                                                          contact_stored_energy(contact))]
   end function balance_terms
 

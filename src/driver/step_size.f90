@@ -25,7 +25,7 @@ contains
     logical :: far(model%nbody)
     integer :: k
     t = huge(1._dp)
-    if (c%nact > 0) return
+    if (c%set%nact > 0) return
     if (any([(norm2(c%obstacle(k)%velocity) > 0, k=1, size(c%obstacle))])) return
     far = .true.
     call clear_near_contact(model, q, qd, dt, c, far)

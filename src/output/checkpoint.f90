@@ -87,15 +87,15 @@ contains
     integer :: k, nact
     if (.not. is_root()) return
     nact = 0
-    if (present(contact)) nact = contact%nact
+    if (present(contact)) nact = contact%set%nact
     if (.not. (all(ieee_is_finite(st%q)) .and. all(ieee_is_finite(st%qd)) .and. &
                all(ieee_is_finite(st%qdd)) .and. ieee_is_finite(st%t))) then
       call fatal_error(err, path//' not written: the state at step '//itoa(st%step)// &
                        ' is not finite (the earlier checkpoint, if any, is kept)'); return
     end if
     if (present(contact)) then
-      if (.not. (all(ieee_is_finite(contact%act(1:nact)%lambda)) .and. &
-                 all(ieee_is_finite(contact%act(1:nact)%mu)))) then
+      if (.not. (all(ieee_is_finite(contact%set%act(1:nact)%lambda)) .and. &
+                 all(ieee_is_finite(contact%set%act(1:nact)%mu)))) then
         call fatal_error(err, path//' not written: contact forces at step '//itoa(st%step)// &
                          ' are not finite (the earlier checkpoint, if any, is kept)'); return
       end if
@@ -109,12 +109,12 @@ contains
       ! direction; then the work summed so far (friction per pair, moving obstacles); last
       ! per pair the impulse so far and the start force of the next step (rows.f90); last
       ! friction's start force per constraint (friction.f90).
-      ints = [level, nact, (contact%act(k)%node, contact%act(k)%pair, contact%act(k)%elem, &
-                            contact%act(k)%side, contact%act(k)%face, contact%act(k)%grip, k=1, nact)]
-      reals = [contact%act(1:nact)%lambda, contact%act(1:nact)%mu, &
-               (contact%act(k)%xi, contact%act(k)%lt, contact%act(k)%mut, contact%act(k)%s, &
+      ints = [level, nact, (contact%set%act(k)%node, contact%set%act(k)%pair, contact%set%act(k)%elem, &
+                            contact%set%act(k)%side, contact%set%act(k)%face, contact%set%act(k)%grip, k=1, nact)]
+      reals = [contact%set%act(1:nact)%lambda, contact%set%act(1:nact)%mu, &
+               (contact%set%act(k)%xi, contact%set%act(k)%lt, contact%set%act(k)%mut, contact%set%act(k)%s, &
                 k=1, nact), contact%friction_work, contact%obstacle_work, &
-               contact%impulse, contact%carry, (contact%act(k)%fa, k=1, nact), contact%act(1:nact)%hold]
+               contact%impulse, contact%carry, (contact%set%act(k)%fa, k=1, nact), contact%set%act(1:nact)%hold]
     else
       ints = [level, 0]
       allocate (reals(0))
@@ -263,11 +263,11 @@ contains
     end if
 
     if (.not. present(contact)) return
-    contact%nact = nact   ! the active set
-    if (allocated(contact%act)) then
-      if (size(contact%act) < nact) deallocate (contact%act)
+    contact%set%nact = nact   ! the active set
+    if (allocated(contact%set%act)) then
+      if (size(contact%set%act) < nact) deallocate (contact%set%act)
     end if
-    if (.not. allocated(contact%act)) allocate (contact%act(nact))
+    if (.not. allocated(contact%set%act)) allocate (contact%set%act(nact))
     contact%time = st%t   ! (obstacles where they are at the checkpoint)
     if (per == 7) then
       contact%friction_work = reals(11*nact + 1:11*nact + contact%npairs)
@@ -288,28 +288,28 @@ contains
     with_fa = size(reals) >= 14*int(nact, int64) + 7*contact%npairs + 1   ! (friction's start forces)
     with_hold = size(reals) == 15*int(nact, int64) + 7*contact%npairs + 1   ! (the depths held)
     do k = 1, nact
-      contact%act(k) = new_constraint(ints(3 + per*(k - 1)), ints(4 + per*(k - 1)))
-      contact%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
+      contact%set%act(k) = new_constraint(ints(3 + per*(k - 1)), ints(4 + per*(k - 1)))
+      contact%set%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
       if (per == 2) cycle   ! (elem = 0: projected again at the first step)
-      contact%act(k)%elem = ints(5 + per*(k - 1))
-      contact%act(k)%side = ints(6 + per*(k - 1))
-      contact%act(k)%face = ints(7 + per*(k - 1):8 + per*(k - 1))
-      contact%act(k)%grip = ints(9 + per*(k - 1))
-      contact%act(k)%mu = reals(nact + k)
+      contact%set%act(k)%elem = ints(5 + per*(k - 1))
+      contact%set%act(k)%side = ints(6 + per*(k - 1))
+      contact%set%act(k)%face = ints(7 + per*(k - 1):8 + per*(k - 1))
+      contact%set%act(k)%grip = ints(9 + per*(k - 1))
+      contact%set%act(k)%mu = reals(nact + k)
       associate (r => reals(2*nact + 9*k - 8:2*nact + 9*k))
-        contact%act(k)%xi = r(1:2); contact%act(k)%lt = r(3:4); contact%act(k)%mut = r(5:6)
-        contact%act(k)%s = r(7:9)
+        contact%set%act(k)%xi = r(1:2); contact%set%act(k)%lt = r(3:4); contact%set%act(k)%mut = r(5:6)
+        contact%set%act(k)%s = r(7:9)
       end associate
       if (with_fa) then
         associate (at => 11*nact + 7*contact%npairs + 1 + 3*(k - 1))
-          contact%act(k)%fa = reals(at + 1:at + 3)
+          contact%set%act(k)%fa = reals(at + 1:at + 3)
         end associate
       end if
-      if (with_hold) contact%act(k)%hold = reals(14*nact + 7*contact%npairs + 1 + k)
+      if (with_hold) contact%set%act(k)%hold = reals(14*nact + 7*contact%npairs + 1 + k)
       ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
       ! that wrote it left them
-      if (contact%act(k)%elem > 0 .or. contact%pair(2, contact%act(k)%pair) <= 0) &
-        call constraint_geometry(contact, model, positions(model, st%q), st%q, contact%act(k), lever=.true.)
+      if (contact%set%act(k)%elem > 0 .or. contact%pair(2, contact%set%act(k)%pair) <= 0) &
+        call constraint_geometry(contact, model, positions(model, st%q), st%q, contact%set%act(k), lever=.true.)
     end do
   contains
     !> the checksum of what was read (the pressure work with the reals, as save_checkpoint)

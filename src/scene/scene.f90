@@ -312,7 +312,7 @@ contains
     if (.not. found) return
     call contact_init(model, pairs, scene_obstacles(deck), deck%contact%tolerance*model%length, &
                       deck%contact%surface == 'faces', c)
-    c%nodal_normal = deck%contact%normal == 'nodal'
+    c%opt%nodal_normal = deck%contact%normal == 'nodal'
     if (deck%contact%stiffness /= unset) call contact_set_stiffness(c, model, deck%contact%stiffness)
     do p = 1, c%npairs
       d = deck%contact%friction; st = deck%contact%static_friction

@@ -62,12 +62,12 @@ contains
       end do
     end do
     if (present(near_pair)) near_pair = .false.
-    do k = 1, contact%nact   ! bodies in contact
-      i = model%node_body(contact%act(k)%node)
+    do k = 1, contact%set%nact   ! bodies in contact
+      i = model%node_body(contact%set%act(k)%node)
       far(i) = .false.
-      j = contact%pair(2, contact%act(k)%pair)
+      j = contact%pair(2, contact%set%act(k)%pair)
       if (j > 0) far(j) = .false.
-      if (present(near_pair)) near_pair(contact%act(k)%pair) = .true.
+      if (present(near_pair)) near_pair(contact%set%act(k)%pair) = .true.
     end do
     do k = 1, contact%npairs  ! an impactor node that could reach the target within two steps
       i = contact%pair(1, k); j = contact%pair(2, k)
@@ -79,9 +79,9 @@ contains
         if (.not. far(i)) cycle
       end if
       if (j > 0) then
-        reach = 2*dt*(speed(i) + speed(j)) + contact%tol + face_reach(contact, model, i, j)
+        reach = 2*dt*(speed(i) + speed(j)) + contact%opt%tol + face_reach(contact, model, i, j)
       else
-        reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%tol + &
+        reach = 2*dt*(speed(i) + norm2(contact%obstacle(-j)%velocity)) + contact%opt%tol + &
                 face_reach(contact, model, i, j)
       end if
       do n = model%body(i)%node_first, model%body(i)%node_last

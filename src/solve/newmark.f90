@@ -60,23 +60,24 @@ contains
 
     g = nm%gamma; dt = nm%dt
     compliant = .false.
-    if (present(contact)) compliant = contact%compliant
+    if (present(contact)) compliant = contact%opt%compliant
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
     allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
       call contact_force_points(contact, model, nm%alpha_f, st%q)   ! (as the last step left them: restarts too)
-      before = contact%act(1:contact%nact)
+      before = contact%set%act(1:contact%set%nact)
       contact%time = st%t + dt   ! (the obstacles where they are at the end of the step)
       contact%x_start = positions(model, st%q); contact%dt = dt
       call contact_step_start(contact)
-      contact%alpha_f = nm%alpha_f; contact%act(1:contact%nact)%g0 = contact%act(1:contact%nact)%gap
+      contact%opt%alpha_f = nm%alpha_f
+      contact%set%act(1:contact%set%nact)%g0 = contact%set%act(1:contact%set%nact)%gap
       contact%g_start = positions(model, st%q, fibres=.true.)   ! (friction's slip)
     end if
     released = [constraint_t ::]
     call attempt(warm=.false.)
     if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
       if (present(contact)) then
-        contact%nact = size(before); contact%act(1:size(before)) = before
+        contact%set%nact = size(before); contact%set%act(1:size(before)) = before
       end if
       return
     end if
@@ -84,7 +85,7 @@ contains
     ! zero with its gap before it is released)
     if (present(contact) .and. (g < 1 .or. nm%alpha_m /= 0) .and. .not. compliant) then
       do k = 1, size(before)
-        if (.not. holds(contact, before(k)%node, before(k)%pair)) released = [released, before(k)]
+        if (.not. holds(contact%set, before(k)%node, before(k)%pair)) released = [released, before(k)]
       end do
       if (size(released) > 0) then
         call timer_start(t_contact)
@@ -94,7 +95,7 @@ contains
         iters = rep%iters
         call attempt(warm=.true.)
         if (allocated(err)) then   ! (the state is as it was: the step is cut)
-          contact%nact = size(before); contact%act(1:size(before)) = before
+          contact%set%nact = size(before); contact%set%act(1:size(before)) = before
           return
         end if
         rep%iters = rep%iters + iters

@@ -133,7 +133,7 @@ contains
     q_entry = q
     if (present(contact)) then
       call contact_solve_start(contact)
-      act_entry = contact%act(1:contact%nact)
+      act_entry = contact%set%act(1:contact%set%nact)
     end if
     ffloor = 0
     if (present(cm)) ffloor = inertial_floor(model, cm, opts%tol)
@@ -198,8 +198,8 @@ contains
     if (.not. allocated(err)) call fatal_error(err, failure_message(rep, rnorm, fref))
     q = q_entry
     if (present(contact)) then
-      contact%nact = size(act_entry)
-      contact%act(1:size(act_entry)) = act_entry
+      contact%set%nact = size(act_entry)
+      contact%set%act(1:size(act_entry)) = act_entry
     end if
   contains
 
@@ -218,7 +218,7 @@ contains
         if (present(qn) .and. present(af)) call contact_force_points(contact, model, af, q, qn)
         call contact_rows(contact, model, asm%eq, asm%neq, rows%irn, rows%jcn, rows%val, rows%gap, &
                           rows%key, rows%fval)
-        version = contact%changes
+        version = contact%set%changes
       else if (.not. allocated(rows%gap)) then
         allocate (rows%irn(0), rows%jcn(0), rows%val(0), rows%gap(0), rows%key(2, 0), rows%fval(0))
       end if
@@ -308,7 +308,7 @@ contains
       inc%g0 = dot_product(inc%dq, res); inc%r0 = rnorm
       inc%alpha = 1; inc%cuts = 0; inc%stale = .not. fresh; inc%set = version
       inc%closing = .false.   ! (the gaps a tenth of the step or more)
-      if (nc > 0) inc%closing = maxval(abs(rows%gap)) > max(contact%tol, 0.1_dp*maxval(abs(inc%dq)))
+      if (nc > 0) inc%closing = maxval(abs(rows%gap)) > max(contact%opt%tol, 0.1_dp*maxval(abs(inc%dq)))
       call move_to(1._dp)
       rep%nincr = rep%nincr + 1
       rep%incr(rep%nincr) = maxval(abs(inc%dq))/model%length
@@ -350,7 +350,7 @@ contains
     logical function gap_open()
       gap_open = .false.
       if (.not. present(contact)) return
-      gap_open = contact_max_gap(contact) > contact%tol
+      gap_open = contact_max_gap(contact) > contact%opt%tol
     end function gap_open
 
   end subroutine newton_solve
@@ -387,7 +387,7 @@ contains
     slip_held = .false.
     if (.not. present(contact)) return
     if (contact%follow_slip .or. contact%hold_slip) return
-    if (.not. any(contact%act(1:contact%nact)%grip == slip)) return
+    if (.not. any(contact%set%act(1:contact%set%nact)%grip == slip)) return
     contact%follow_slip = .true.; follow_start = it
     slip_held = .true.
   end function slip_held

@@ -63,14 +63,14 @@ contains
     character(len=120) :: msg
     type(constraint_t), allocatable :: before(:)
     at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tried = .false.
-    if (present(contact)) contact%stick_at_touch = .true.
+    if (present(contact)) contact%opt%stick_at_touch = .true.
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
       if (present(contact)) then   ! (friction's slip is over the load increment)
-        do k = 1, contact%nact
-          contact%act(k)%u0 = 0
+        do k = 1, contact%set%nact
+          contact%set%act(k)%u0 = 0
         end do
-        before = contact%act(1:contact%nact)
+        before = contact%set%act(1:contact%set%nact)
         contact%x_start = positions(model, q); contact%g_start = positions(model, q, fibres=.true.)
       end if
       call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
@@ -127,7 +127,7 @@ contains
 
     allocate (q_entry, source=q)   ! (explicitly: gcc 12 warned of the descriptor)
     q_n = q
-    if (present(contact)) act_entry = contact%act(1:contact%nact)
+    if (present(contact)) act_entry = contact%set%act(1:contact%set%nact)
     c0 = stabilisation(model); c = c0
     fresh = opts
     fresh%reuse = .false.   ! (kept factors are of another c, or of the singular tangent)
@@ -187,7 +187,7 @@ contains
     rep%iters = iters
     q = q_entry
     if (present(contact)) then
-      contact%nact = size(act_entry); contact%act(1:size(act_entry)) = act_entry
+      contact%set%nact = size(act_entry); contact%set%act(1:size(act_entry)) = act_entry
     end if
   contains
     !> From the stabilised state, Newton without the stabilising force: the equilibrium
