@@ -192,6 +192,8 @@ with open(mixed_msh, "w") as f:   # one 10-node triangle and one 4-node quadrang
 cases = [  # (name, text transformation, substrings the message must hold)
     ("missing deck file", None, ["no_such_deck.nml", "cannot open"]),
     ("unknown group", lambda s: s.replace("&output", "&outptu"), ["&outptu", ":4:"]),
+    ("an unknown group and a bad value", lambda s: s.replace("&output", "&outptu").replace("young = 210e9", "young = -1.0", 1),
+     ["&outptu", ":4:", "young must be > 0", "2 problems in the deck"]),
     ("misspelt key", lambda s: s.replace("velocity", "velocty"), ["velocty", "velocity", ":11:"]),
     ("wrong type", lambda s: s.replace("dt = 5.0e-5", "dt = 'fast'"), ["dt", "not a number", ":2:"]),
     ("a key given twice", lambda s: s.replace("  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n",

@@ -149,6 +149,9 @@ module casca_deck
     type(obstacle_cfg_t), allocatable :: obstacles(:)
     integer :: nproblems = 0
     character(len=512), allocatable :: problems(:)
+    !> of the problems, misspelt group names: those groups are left out and the rest of the
+    !> deck is still read and checked, so that one typo does not hide the other problems
+    integer :: unknown_groups = 0
   end type deck_t
 
 contains
@@ -225,7 +228,7 @@ contains
       return
     end if
     call scan_groups(u, deck, gname, gline)
-    if (deck%nproblems > 0) then
+    if (deck%nproblems > deck%unknown_groups) then
       close (u); return
     end if
     call read_run(u, deck, line_of('run', 1))
@@ -440,6 +443,7 @@ contains
       if (all(known_groups /= name)) then
         call add_problem(deck, n, 'unknown group &'//trim(name)// &
                          ' (known: &run, &output, &body, &restraint, &load, &contact, &obstacle)')
+        deck%unknown_groups = deck%unknown_groups + 1
         cycle
       end if
       if (name == 'end') cycle
