@@ -151,6 +151,9 @@ module casca_contact
     !> per node: on its shell's free edge (the rim), the only place a node can touch edge-on
     logical, allocatable :: rim(:)
     real(dp), allocatable :: mu_d(:), mu_s(:)   !< Coulomb friction per pair: dynamic, static
+    !> per pair: the slip speed over which the sliding coefficient falls from mu_s towards
+    !> mu_d by 1/e, 1/DC of friction_decay [m/s] (rows.f90, sliding_coefficient); 0: at once
+    real(dp), allocatable :: v_decay(:)
     type(target_geometry_t) :: geo
     type(active_set_t) :: set
     ! the step: its start positions and fibres and its length (friction needs them: without
@@ -208,8 +211,9 @@ contains
         end do
       end associate
     end do
-    allocate (c%set%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%friction_work(c%npairs))
-    c%mu_d = 0; c%mu_s = 0; c%friction_work = 0
+    allocate (c%set%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%v_decay(c%npairs), &
+              c%friction_work(c%npairs))
+    c%mu_d = 0; c%mu_s = 0; c%v_decay = 0; c%friction_work = 0
     c%opt%slip_floor = slip_share*model%length
     allocate (c%impulse(3, c%npairs), c%carry(3, c%npairs))
     c%impulse = 0; c%carry = 0

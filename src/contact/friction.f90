@@ -1,6 +1,7 @@
 !> Coulomb friction on the active constraints (static coefficient mu_s, dynamic mu_d per
 !> pair). A constraint sticks (two Lagrange rows: no relative tangential displacement over
-!> the step) or slides (a force mu_d |lambda| against its slip direction s: the slip over
+!> the step) or slides (a force mu |lambda| against its slip direction s, mu = mu_d or, with
+!> friction_decay, falling from mu_s to mu_d with the slip speed (rows.f90): the slip over
 !> the step at each Newton iterate, friction_geometry, with its stiffness across s in
 !> Newton's rows, contact_rows; held while the slip is below the slip floor). The return
 !> mapping between the two is an active-set change, made where Newton has converged, like

@@ -127,10 +127,10 @@ contains
   !> each multiplier (zero, or minus a compliant normal row's compliance), the rows' residuals
   !> (the gaps, less compliance times lambda), and each row's key (node and kind, element).
   !> fval: the same entries of the columns the multipliers act through: C^T where the force
-  !> acts (force_point), and for a sliding constraint's normal row n - mu_d s there
-  !> (its friction follows |lambda|).
+  !> acts (force_point), and for a sliding constraint's normal row n - mu s there
+  !> (its friction follows |lambda|; mu its sliding coefficient).
   !> A sliding constraint's force turns with its slip (s = ut / |ut|, friction_geometry):
-  !> across s it is as stiff as k = mu_d |lambda| / |ut|, which Newton needs (without it
+  !> across s it is as stiff as k = mu |lambda| / |ut|, which Newton needs (without it
   !> the turn overshoots where k is as stiff as the node). That stiffness, k B_e^T C_e (e
   !> across s, B at the force's point, C at the gap's), is the row across s with compliance
   !> 1/k and no gap: eliminated, its multiplier adds it to K. The multiplier is an
@@ -173,7 +173,7 @@ contains
           call constraint_row(c%set%act(k), model, d, vf, nd, kind, force=.true.)
         mu = 0; ns = 0
         if (kind == 0 .and. c%set%act(k)%grip == slip .and. c%set%act(k)%lambda < 0) then
-          mu = c%mu_d(c%set%act(k)%pair); key(1, r) = 4*c%set%act(k)%node + 3
+          mu = sliding_coefficient(c, c%set%act(k)); key(1, r) = 4*c%set%act(k)%node + 3
           call constraint_row(c%set%act(k), model, d, vs, ns, 3, force=.true.)   ! (the same points first)
         end if
         w = 1   ! (the row's weight: 0 for an empty row across a held s)
@@ -197,7 +197,7 @@ contains
     irn = irn(1:m); jcn = jcn(1:m); val = val(1:m); fval = fval(1:m)
   end subroutine contact_rows
 
-  !> The sliding force's stiffness across its slip, mu_d |lambda| / |ut|, where s follows the
+  !> The sliding force's stiffness across its slip, mu |lambda| / |ut|, where s follows the
   !> slip (friction_geometry); 0 where s is held or the force is 0
   pure real(dp) function slip_stiffness(c, a)
     type(contact_t), intent(in) :: c
@@ -206,13 +206,34 @@ contains
     if (slip_followed(c, a)) slip_stiffness = slip_force(c, a)/norm2(a%ut)
   end function slip_stiffness
 
-  !> The sliding force's multiplier on the row along s: mu_d |lambda| (0 unless sliding)
+  !> The sliding force's multiplier on the row along s: mu |lambda| (0 unless sliding), mu
+  !> the sliding coefficient (sliding_coefficient)
   pure real(dp) function slip_force(c, a)
     type(contact_t), intent(in) :: c
     type(constraint_t), intent(in) :: a
     slip_force = 0
-    if (a%grip == slip) slip_force = c%mu_d(a%pair)*max(-a%lambda, 0._dp)
+    if (a%grip == slip) slip_force = sliding_coefficient(c, a)*max(-a%lambda, 0._dp)
   end function slip_force
+
+  !> The coefficient of a sliding constraint: mu_d, or where its pair has a decay speed v_c
+  !> (friction_decay DC = 1/v_c, LS-DYNA's), mu_d + (mu_s - mu_d) exp(-|v| / v_c) with v its
+  !> slip speed, its slip over the step at this iterate over dt. A node that starts to slide
+  !> keeps about mu_s until it moves: dropped to mu_d at once, the edge nodes of a plate at
+  !> rest on an incline, which carry its bending and pass mu_s though the plate is well inside
+  !> the cone, shed their load row after row and the whole plate slid at mu_d
+  !> (docs/performance.md). Statics have no time: mu_d. The coefficient's fall with the slip
+  !> is not in Newton's rows (a negative stiffness along s): followed by fixed point, for a
+  !> body sliding under its weight each iterate's error shrinks by about
+  !> (mu_s - mu_d) g_n beta dt exp(-|v| / v_c) / v_c, g_n the weight's normal part per mass:
+  !> 0.1 to 0.2 on that plate at DC 100 s/m and dt 1 ms
+  pure real(dp) function sliding_coefficient(c, a)
+    type(contact_t), intent(in) :: c
+    type(constraint_t), intent(in) :: a
+    sliding_coefficient = c%mu_d(a%pair)
+    if (.not. (c%v_decay(a%pair) > 0 .and. c%dt > 0)) return
+    sliding_coefficient = sliding_coefficient + (c%mu_s(a%pair) - c%mu_d(a%pair))* &
+                          exp(-norm2(a%ut)/c%dt/c%v_decay(a%pair))
+  end function sliding_coefficient
 
   !> f = C^T lambda (ndof) with the friction: minus the contact forces, on the fibres too
   !> between faces, every row where the force acts (force_point)

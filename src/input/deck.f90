@@ -119,6 +119,9 @@ module casca_deck
     real(dp) :: static_friction = unset         !< static coefficient (default: friction)
     !> per listed pair (pairs(:, k)): its own coefficients (default: the two above)
     real(dp) :: pair_friction(max_pairs) = unset, pair_static_friction(max_pairs) = unset
+    !> decay of the sliding coefficient with the slip speed, LS-DYNA's DC [s/m] (unset: from
+    !> static to dynamic at once); per listed pair its own (default &contact's)
+    real(dp) :: friction_decay = unset, pair_friction_decay(max_pairs) = unset
     integer :: line = 0
   end type contact_cfg_t
 
@@ -132,6 +135,7 @@ module casca_deck
     logical :: inside = .false.                 !< sphere, cylinder: the bodies are inside
     real(dp) :: velocity(3) = 0
     real(dp) :: friction = unset, static_friction = unset   !< (default: &contact's)
+    real(dp) :: friction_decay = unset          !< (default: &contact's)
     integer :: nbodies = 0                      !< 0: every body
     character(len=64) :: bodies(max_pairs) = ''
     integer :: line = 0
@@ -369,9 +373,10 @@ contains
       character(len=long) :: name, shape
       character(len=256) :: bodies(max_pairs)
       real(dp) :: point(3), normal(3), axis(3), radius, velocity(3), friction, static_friction
+      real(dp) :: friction_decay
       logical :: inside
       namelist /obstacle/ name, shape, point, normal, axis, radius, inside, velocity, bodies, &
-        friction, static_friction
+        friction, static_friction, friction_decay
       type(obstacle_cfg_t) :: o
       integer :: io, k
       rewind (uu)
@@ -379,7 +384,7 @@ contains
         o = obstacle_cfg_t()
         name = o%name; shape = o%shape; point = o%point; normal = o%normal; axis = o%axis
         radius = o%radius; inside = o%inside; velocity = o%velocity; bodies = ''
-        friction = o%friction; static_friction = o%static_friction
+        friction = o%friction; static_friction = o%static_friction; friction_decay = o%friction_decay
         read (uu, nml=obstacle, iostat=ios, iomsg=msg)
         if (ios /= 0) then
           call add_problem(dk, line_of('obstacle', io), '&obstacle: '//trim(msg))
@@ -390,7 +395,7 @@ contains
         call take(dk, o%line, '&obstacle: shape', lower(shape), o%shape)
         o%point = point; o%normal = normal; o%axis = axis; o%radius = radius
         o%inside = inside; o%velocity = velocity
-        o%friction = friction; o%static_friction = static_friction
+        o%friction = friction; o%static_friction = static_friction; o%friction_decay = friction_decay
         do k = 1, max_pairs
           if (bodies(k) == '') exit
           o%nbodies = k
@@ -549,17 +554,18 @@ contains
     logical :: enabled
     character(len=long) :: solver, normal, surface
     character(len=256) :: pairs(2, max_pairs)   ! (longer than a name: enough to see one too long)
-    real(dp) :: tolerance, friction, static_friction, stiffness
-    real(dp) :: pair_friction(max_pairs), pair_static_friction(max_pairs)
+    real(dp) :: tolerance, friction, static_friction, stiffness, friction_decay
+    real(dp) :: pair_friction(max_pairs), pair_static_friction(max_pairs), pair_friction_decay(max_pairs)
     character(len=256) :: msg
     integer :: ios, k, passes
     namelist /contact/ enabled, pairs, tolerance, solver, normal, surface, passes, friction, &
-      static_friction, pair_friction, pair_static_friction, stiffness
+      static_friction, pair_friction, pair_static_friction, stiffness, friction_decay, pair_friction_decay
     associate (c => deck%contact)
       enabled = c%enabled; pairs = ''; tolerance = c%tolerance; solver = c%solver; normal = c%normal
       stiffness = c%stiffness
       surface = c%surface; passes = c%passes; friction = c%friction; static_friction = c%static_friction
       pair_friction = c%pair_friction; pair_static_friction = c%pair_static_friction
+      friction_decay = c%friction_decay; pair_friction_decay = c%pair_friction_decay
       c%line = line
       if (line == 0) return
       rewind (u)
@@ -573,6 +579,7 @@ contains
       call take(deck, line, '&contact: surface', lower(surface), c%surface)
       c%passes = passes; c%friction = friction; c%static_friction = static_friction
       c%pair_friction = pair_friction; c%pair_static_friction = pair_static_friction
+      c%friction_decay = friction_decay; c%pair_friction_decay = pair_friction_decay
       c%npairs = 0
       do k = 1, max_pairs
         if (pairs(1, k) == '' .and. pairs(2, k) == '') exit

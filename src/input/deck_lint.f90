@@ -48,12 +48,14 @@ module casca_deck_lint
     key_t('contact', 'stiffness', 'r'), &
     key_t('contact', 'static_friction', 'r'), key_t('contact', 'pair_friction', 'r'), &
     key_t('contact', 'pair_static_friction', 'r'), key_t('contact', 'passes', 'i'), &
+    key_t('contact', 'friction_decay', 'r'), key_t('contact', 'pair_friction_decay', 'r'), &
     key_t('contact', 'enabled', 'l'), key_t('obstacle', 'name', 's'), &
     key_t('obstacle', 'shape', 's'), key_t('obstacle', 'bodies', 's'), &
     key_t('obstacle', 'point', 'r'), key_t('obstacle', 'normal', 'r'), &
     key_t('obstacle', 'axis', 'r'), key_t('obstacle', 'radius', 'r'), &
     key_t('obstacle', 'velocity', 'r'), key_t('obstacle', 'friction', 'r'), &
-    key_t('obstacle', 'static_friction', 'r'), key_t('obstacle', 'inside', 'l')]
+    key_t('obstacle', 'static_friction', 'r'), key_t('obstacle', 'friction_decay', 'r'), &
+    key_t('obstacle', 'inside', 'l')]
 
   !> The string keys that take a list (every other string key takes one)
   character(len=10), parameter :: str_lists(*) = [character(len=10) :: 'track_body', 'pairs', 'bodies']

@@ -222,16 +222,19 @@ contains
     if (deck%contact%passes /= 1 .and. deck%contact%passes /= 2) &
       call add_problem(deck, deck%contact%line, '&contact: passes must be 1 or 2')
     call check_friction(deck%contact%line, '&contact', deck%contact%friction, deck%contact%static_friction)
+    call check_decay(deck%contact%line, '&contact: friction_decay', deck%contact%friction_decay)
     do j = 1, size(deck%contact%pair_friction)
       associate (c => deck%contact)
-        if (c%pair_friction(j) == unset .and. c%pair_static_friction(j) == unset) cycle
+        if (c%pair_friction(j) == unset .and. c%pair_static_friction(j) == unset .and. &
+            c%pair_friction_decay(j) == unset) cycle
         if (j > c%npairs) then
-          call add_problem(deck, c%line, '&contact: pair_friction('//itoa(j)//') given for pair '// &
+          call add_problem(deck, c%line, '&contact: '//pair_key(j)//'('//itoa(j)//') given for pair '// &
                            itoa(j)//', but pairs lists '//itoa(c%npairs))
           cycle
         end if
         call check_friction(c%line, '&contact: pair '//itoa(j), merge(c%pair_friction(j), c%friction, &
                             c%pair_friction(j) /= unset), c%pair_static_friction(j))
+        call check_decay(c%line, '&contact: pair_friction_decay('//itoa(j)//')', c%pair_friction_decay(j))
       end associate
     end do
     do i = 1, size(deck%obstacles)
@@ -277,6 +280,7 @@ contains
       end select
       if (o%friction /= unset .or. o%static_friction /= unset) call check_friction(o%line, &
         '&obstacle', merge(o%friction, deck%contact%friction, o%friction /= unset), o%static_friction)
+      call check_decay(o%line, '&obstacle: friction_decay', o%friction_decay)
       do k = 1, o%nbodies
         if (find_body(o%bodies(k)) == 0) call add_problem(deck, o%line, '&obstacle: bodies = '// &
           no_body(o%bodies(k)))
@@ -312,6 +316,27 @@ contains
                          ') must not be below friction ('//rtoa(dyn)//')')
       end if
     end subroutine check_friction
+
+    !> the first of &contact's per-pair friction keys given for pair j
+    function pair_key(j) result(key)
+      integer, intent(in) :: j
+      character(len=:), allocatable :: key
+      key = 'pair_friction_decay'
+      if (deck%contact%pair_static_friction(j) /= unset) key = 'pair_static_friction'
+      if (deck%contact%pair_friction(j) /= unset) key = 'pair_friction'
+    end function pair_key
+
+    !> a decay coefficient of the sliding coefficient with slip speed, DC [s/m], when given:
+    !> finite and >= 0 (0: the static coefficient at any speed, as LS-DYNA reads it)
+    subroutine check_decay(line, field, dc)
+      integer, intent(in) :: line
+      character(len=*), intent(in) :: field
+      real(dp), intent(in) :: dc
+      if (dc == unset) return
+      if (.not. (dc >= 0 .and. dc < huge(1._dp))) call add_problem(deck, line, field// &
+        ' must be >= 0 [s/m], the decay of the sliding coefficient with the slip speed v, '// &
+        'mu_d + (mu_s - mu_d) exp(-friction_decay |v|) (got '//rtoa(dc)//')')
+    end subroutine check_decay
 
     subroutine unit_vector(line, field, v)
       integer, intent(in) :: line

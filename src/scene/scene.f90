@@ -306,7 +306,7 @@ contains
     logical, intent(out) :: found
     integer, allocatable :: pairs(:, :)
     integer :: p, t, j
-    real(dp) :: d, st
+    real(dp) :: d, st, dc
     allocate (pairs, source=contact_pairs(deck, model))   ! (not on assignment: gfortran warns)
     found = size(pairs, 2) > 0
     if (.not. found) return
@@ -315,18 +315,21 @@ contains
     c%opt%nodal_normal = deck%contact%normal == 'nodal'
     if (deck%contact%stiffness /= unset) call contact_set_stiffness(c, model, deck%contact%stiffness)
     do p = 1, c%npairs
-      d = deck%contact%friction; st = deck%contact%static_friction
+      d = deck%contact%friction; st = deck%contact%static_friction; dc = deck%contact%friction_decay
       t = c%pair(2, p)
       if (t < 0) then
         call own(deck%obstacles(-t)%friction, deck%obstacles(-t)%static_friction)
+        if (deck%obstacles(-t)%friction_decay /= unset) dc = deck%obstacles(-t)%friction_decay
       else
         do j = 1, deck%contact%npairs
           if (.not. same_bodies(deck%contact%pairs(:, j), c%pair(1, p), t)) cycle
           call own(deck%contact%pair_friction(j), deck%contact%pair_static_friction(j))
+          if (deck%contact%pair_friction_decay(j) /= unset) dc = deck%contact%pair_friction_decay(j)
         end do
       end if
       c%mu_d(p) = d
       c%mu_s(p) = merge(st, d, st /= unset)
+      if (dc /= unset) c%v_decay(p) = decay_speed(dc)
     end do
   contains
     !> A pair's or obstacle's own coefficients replace &contact's; its own dynamic one alone
@@ -339,6 +342,14 @@ contains
       end if
       if (sta /= unset) st = sta
     end subroutine own
+
+    !> The slip speed v_c over which the sliding coefficient falls by 1/e, 1/DC [m/s]: DC 0
+    !> keeps the static coefficient at any speed (huge v_c)
+    pure real(dp) function decay_speed(dc)
+      real(dp), intent(in) :: dc
+      decay_speed = huge(1._dp)
+      if (dc > 1/huge(1._dp)) decay_speed = 1/dc   ! (1/dc overflows below that)
+    end function decay_speed
 
     !> the two names are bodies a and b, either way round
     logical function same_bodies(names, a, b)
