@@ -116,7 +116,7 @@ contains
     logical, intent(in), optional :: gaps
     integer :: i
     call read_deck(path, deck)
-    if (deck%nproblems == deck%unknown_groups) call check_deck(deck)   ! (the others' values too)
+    if (deck%nproblems == deck%readable_problems) call check_deck(deck)   ! (the others' values too)
     if (deck%nproblems == 0) call build_model(deck, model)
     if (deck%nproblems == 0) call check_overlap()
     if (present(gaps)) then

@@ -153,9 +153,10 @@ module casca_deck
     type(obstacle_cfg_t), allocatable :: obstacles(:)
     integer :: nproblems = 0
     character(len=512), allocatable :: problems(:)
-    !> of the problems, misspelt group names: those groups are left out and the rest of the
-    !> deck is still read and checked, so that one typo does not hide the other problems
-    integer :: unknown_groups = 0
+    !> of the problems, those that leave the rest of the deck readable (a misspelt group name,
+    !> the group left out; a contradiction between values read): the other groups are still
+    !> read and their values checked, so that one slip does not hide the other problems
+    integer :: readable_problems = 0
   end type deck_t
 
 contains
@@ -232,7 +233,7 @@ contains
       return
     end if
     call scan_groups(u, deck, gname, gline)
-    if (deck%nproblems > deck%unknown_groups) then
+    if (deck%nproblems > deck%readable_problems) then
       close (u); return
     end if
     call read_run(u, deck, line_of('run', 1))
@@ -448,7 +449,7 @@ contains
       if (all(known_groups /= name)) then
         call add_problem(deck, n, 'unknown group &'//trim(name)// &
                          ' (known: &run, &output, &body, &restraint, &load, &contact, &obstacle)')
-        deck%unknown_groups = deck%unknown_groups + 1
+        deck%readable_problems = deck%readable_problems + 1
         cycle
       end if
       if (name == 'end') cycle
@@ -497,8 +498,11 @@ contains
       call take(deck, line, '&run: factor_precision', lower(factor_precision), c%factor_precision)
       c%dt = dt; c%t_end = t_end; c%rho_inf = rho_inf
       c%tolerance = tolerance; c%tolerance_length = tolerance_length
-      if (rho_inf /= unset .and. (beta /= unset .or. gamma /= unset)) call add_problem(deck, line, &
-        '&run: give either rho_inf (generalized-alpha) or beta and gamma (Newmark), not both')
+      if (rho_inf /= unset .and. (beta /= unset .or. gamma /= unset)) then
+        call add_problem(deck, line, &
+          '&run: give either rho_inf (generalized-alpha) or beta and gamma (Newmark), not both')
+        deck%readable_problems = deck%readable_problems + 1
+      end if
       if (beta /= unset) c%beta = beta
       if (gamma /= unset) c%gamma = gamma
       ! an error asked for and no scheme named: a second-order one, whose local error falls as
