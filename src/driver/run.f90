@@ -627,9 +627,9 @@ contains
     if (err > 1.25_dp .and. ok .and. .not. r%floor_told) then
       ! (once, and clearly above: the answer is then the shortest step's, not the tolerance's)
       r%floor_told = .true.
-      if (is_root()) write (0, '(a)') 'warning: the step to t = '//rtoa(r%st%t)//' s is '// &
-        rtoa(err)//' times the tolerance at the shortest step allowed, dt / 2^max_step_cuts = '// &
-        rtoa(r%sc%dt_min)//' s, and was kept: the tolerance is not met there; give a shorter '// &
+      if (is_root()) write (0, '(a)') 'warning: the step of '//rtoa(h)//' s to t = '//rtoa(r%st%t)// &
+        ' s is '//rtoa(err)//' times the tolerance, at or below the shortest step allowed, dt / '// &
+        '2^max_step_cuts = '//rtoa(r%sc%dt_min)//' s, and was kept: the tolerance is not met there; give a shorter '// &
         'dt or a larger max_step_cuts (&run) for it'
     end if
     if (ok .and. ratio >= 1) then   ! (a step cut short by a frame or the grid does not shorten it)
@@ -937,12 +937,25 @@ contains
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
     if (is_root() .and. squeezed(r)) then
       write (0, '(a)') 'hint: '//squeeze_note(r)
+    else if (is_root() .and. index(reason, 'did not settle') > 0 .and. sudden_static_friction()) then
+      ! (a plate at rest on an incline: its edge nodes pass the static cone first and shed
+      ! their load row after row within the step, docs/performance.md)
+      write (0, '(a)') 'hint: static_friction is above friction with no friction_decay: a node '// &
+        'past its static cone drops at once to the dynamic coefficient and sheds its load onto '// &
+        'its neighbours, which may slip in turn within the step; friction_decay (&contact, '// &
+        'e.g. 100 s/m) lets the drop follow the slip speed (README)'
     else if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') then
       write (0, '(a)') 'hint: '//r%nm%describe()//' keeps the shells'' fastest vibrations '// &
         'undamped, which can stall Newton; rho_inf = 0.8 (generalized-alpha) damps them, '// &
         'second order (or beta = 0.3025, gamma = 0.6; or the thesis'' beta = 1, gamma = 1.5)'
     end if
     r%code = exit_solver
+  contains
+    logical function sudden_static_friction()
+      sudden_static_friction = .false.
+      if (allocated(r%contact)) sudden_static_friction = &
+        any(r%contact%mu_s > r%contact%mu_d .and. .not. r%contact%v_decay > 0)
+    end function sudden_static_friction
   end subroutine give_up
 
   !> Close the files, draw the plots, print the summary (and, for a dynamic run from t = 0,
