@@ -937,7 +937,8 @@ contains
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
     if (is_root() .and. squeezed(r)) then
       write (0, '(a)') 'hint: '//squeeze_note(r)
-    else if (is_root() .and. index(reason, 'did not settle') > 0 .and. sudden_static_friction()) then
+    else if (is_root() .and. sudden_static_friction() .and. &
+             (index(reason, 'did not settle') > 0 .or. index(reason, 'did not converge') > 0)) then
       ! (a plate at rest on an incline: its edge nodes pass the static cone first and shed
       ! their load row after row within the step, docs/performance.md)
       write (0, '(a)') 'hint: static_friction is above friction with no friction_decay: a node '// &
