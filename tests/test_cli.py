@@ -195,7 +195,7 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("an unknown group and a bad value", lambda s: s.replace("&output", "&outptu").replace("young = 210e9", "young = -1.0", 1),
      ["&outptu", ":4:", "young must be > 0", "2 problems in the deck"]),
     ("a scheme given twice and an unknown body", lambda s: s.replace("dt = 5.0e-5", "dt = 5.0e-5, rho_inf = 0.8, beta = 0.3")
-     + "&restraint\n body = 'ring9', fix = 'y'\n/\n", [":1:", "not both", ":18:", "'ring9' is not a body", "2 problems"]),
+     + "&restraint\n body = 'ring9', fix = 'y'\n/\n", [":1:", "not both", ":19:", "'ring9' is not a body", "2 problems"]),
     ("misspelt key", lambda s: s.replace("velocity", "velocty"), ["velocty", "velocity", ":11:"]),
     ("wrong type", lambda s: s.replace("dt = 5.0e-5", "dt = 'fast'"), ["dt", "not a number", ":2:"]),
     ("a key given twice", lambda s: s.replace("  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n",
@@ -243,7 +243,7 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("groups closed with &end", lambda s: s.replace("/\n&output", "&end\n&output", 1),
      ["&run is closed with &end (line 3)", ":1:"]),
     ("names making one history column", lambda s: s.replace("'ring1'", "'ring 1'").replace("'ring2'", "'ring_1'"),
-     ["name 'ring_1' and 'ring 1' make the same history column name 'ring_1'", ":14:"]),
+     ["name 'ring_1' and 'ring 1' make the same history column name 'ring_1'", ":15:"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),
     ("missing required value", lambda s: s.replace("young = 210e9, ", "", 1), ["young", "missing"]),

@@ -120,7 +120,7 @@ if hs is not None and hb is not None:
 # missing
 text = cantilever("strip_sets_v41.msh", "set = 'clamped'", "set = 'tp'")
 _, p, deck = run_deck("missing", text)
-line = 1 + text.splitlines().index("&load")
+line = 1 + next(i for i, l in enumerate(text.splitlines()) if "set = 'tp'" in l)   # (the key's line)
 want = "%s:%d: &load: set 'tp' is not a physical group of body 'strip' (its groups: clamped, tip, strip)" \
     % (deck, line)
 ck.record("missing: exit 2", p.returncode == 2, "exit %d" % p.returncode)

@@ -157,6 +157,10 @@ module casca_deck
     !> the group left out; a contradiction between values read): the other groups are still
     !> read and their values checked, so that one slip does not hide the other problems
     integer :: readable_problems = 0
+    !> each key given in a group, with the line of its group and its own line: a problem
+    !> found in a value is reported at the key's line (add_problem)
+    character(len=20), allocatable :: key_name(:)
+    integer, allocatable :: key_group_line(:), key_line(:)
   end type deck_t
 
 contains
@@ -173,12 +177,16 @@ contains
     end if
   end function deck_file
 
-  subroutine add_problem(deck, line, msg)
+  !> A problem of the deck at line (0: of the deck as a whole). A message about a value,
+  !> '&group [name]: key ...' given a group's first line, is moved to that key's line.
+  subroutine add_problem(deck, line_given, msg)
     type(deck_t), intent(inout) :: deck
-    integer, intent(in) :: line
+    integer, intent(in) :: line_given
     character(len=*), intent(in) :: msg
     character(len=512), allocatable :: tmp(:)
     character(len=16) :: ls
+    integer :: line
+    line = key_line_of(deck, line_given, msg)
     if (.not. allocated(deck%problems)) allocate (deck%problems(16))
     if (deck%nproblems == size(deck%problems)) then
       allocate (tmp(2*size(deck%problems)))
@@ -193,6 +201,28 @@ contains
       deck%problems(deck%nproblems) = deck%path//': '//msg
     end if
   end subroutine add_problem
+
+  !> The line of the key a message names after its group ('&body a: poisson must ...'), if
+  !> line is the first line of a group that gave that key; else line
+  pure integer function key_line_of(deck, line, msg) result(at)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: line
+    character(len=*), intent(in) :: msg
+    integer :: i, j, k
+    at = line
+    if (line <= 0 .or. .not. allocated(deck%key_name) .or. msg(1:min(1, len(msg))) /= '&') return
+    i = index(msg, ': ')
+    if (i == 0) return
+    j = i + 2
+    k = verify(msg(j:), 'abcdefghijklmnopqrstuvwxyz0123456789_')
+    if (k == 1) return
+    if (k == 0) k = len(msg) - j + 2
+    do i = 1, size(deck%key_name)
+      if (deck%key_group_line(i) == line .and. deck%key_name(i) == msg(j:j + k - 2)) then
+        at = deck%key_line(i); return
+      end if
+    end do
+  end function key_line_of
 
   !> dest = text, or a problem naming the field if text does not fit in dest
   subroutine take(deck, line, field, text, dest)
@@ -418,8 +448,9 @@ contains
     character(len=max_line_len), allocatable :: text(:)
     character(len=16) :: name
     integer :: ios, n, j, k, nread
-    integer, allocatable :: lines(:)
+    integer, allocatable :: lines(:), key_lines(:)
     character(len=512), allocatable :: msgs(:)
+    character(len=20), allocatable :: keys(:)
 
     allocate (gname(0), gline(0), text(0))
     n = 0
@@ -456,11 +487,15 @@ contains
       gname = [character(len=16) :: gname, name]; gline = [gline, n]
     end do
     rewind (u)
+    allocate (deck%key_name(0), deck%key_group_line(0), deck%key_line(0))
     do k = 1, size(gname)
-      call lint_group(text, gline(k), trim(gname(k)), lines, msgs)
+      call lint_group(text, gline(k), trim(gname(k)), lines, msgs, keys, key_lines)
       do j = 1, size(lines)
         call add_problem(deck, lines(j), trim(msgs(j)))
       end do
+      deck%key_name = [deck%key_name, keys]
+      deck%key_group_line = [deck%key_group_line, spread(gline(k), 1, size(keys))]
+      deck%key_line = [deck%key_line, key_lines]
     end do
   end subroutine scan_groups
 

@@ -81,12 +81,15 @@ contains
 
   !> Check the group whose '&name' is on line first of text(:). Each problem is returned as
   !> a line number and a message (returned, not reported through a callback: an internal
-  !> procedure passed as an argument would need a trampoline on an executable stack).
-  subroutine lint_group(text, first, group, lines, msgs)
+  !> procedure passed as an argument would need a trampoline on an executable stack); and
+  !> each key given (not indexed), with its line.
+  subroutine lint_group(text, first, group, lines, msgs, keys, key_lines)
     character(len=*), intent(in) :: text(:), group
     integer, intent(in) :: first
     integer, allocatable, intent(out) :: lines(:)
     character(len=512), allocatable, intent(out) :: msgs(:)
+    character(len=20), allocatable, intent(out) :: keys(:)
+    integer, allocatable, intent(out) :: key_lines(:)
     character(len=:), allocatable :: s, key, item
     integer, allocatable :: lineof(:)
     integer :: i, j, k, n, p
@@ -98,7 +101,7 @@ contains
     logical :: indexed, comma   !< comma: the last item was a comma
 
     ! the group as one string (comments cut), with the line of each character
-    allocate (lines(0), msgs(0))
+    allocate (lines(0), msgs(0), keys(0), key_lines(0))
     s = ''
     allocate (lineof(0))
     do i = first, size(text)
@@ -254,6 +257,7 @@ contains
       end do
       seen = [character(len=20) :: seen, key]
       seen_line = [seen_line, key_line]
+      keys = seen; key_lines = seen_line
     end subroutine once
 
     !> The key just read is complete: a vector of three takes three numbers (the read fills
