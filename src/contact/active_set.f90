@@ -218,7 +218,7 @@ contains
     type(contact_t), intent(inout) :: c
     integer :: k
     c%set%changes = 0
-    c%set%nseen = 0; c%set%cycling = .false.
+    c%set%nseen = 0; c%set%cycling = .false.; c%set%decisions = 0
     c%follow_slip = .false.; c%hold_slip = .false.
     c%set%act(1:c%set%nact)%flips = 0
     do k = 1, c%set%nact
@@ -229,27 +229,27 @@ contains
   !> Where Newton has converged for the set: stick/slip changes first, else releases and new
   !> penetrations (which also measures the gaps at q). A trial stick's multiplier may be
   !> tensile only because it stopped the sliding: released first, the node would be taken
-  !> again, step after step. changed: how many changes; grips: they were stick/slip changes
-  !> only (bounded: friction_update turns each node at most three times in a step). With
-  !> stick = .false. (an iterate near convergence, not converged) stick and slip are left for
-  !> later: Coulomb's law has more than one consistent state, and a hoop rolling from node to
-  !> node, whose stick or slip was decided early, made four times the energy in a step.
-  subroutine contact_settle(c, model, q, stick, changed, grips)
+  !> again, step after step. changed: how many changes; a release or new contact is one of
+  !> the solve's decisions (active_set_t%decisions). With stick = .false. (an iterate near
+  !> convergence, not converged) stick and slip are left for later: Coulomb's law has more
+  !> than one consistent state, and a hoop rolling from node to node, whose stick or slip was
+  !> decided early, made four times the energy in a step.
+  subroutine contact_settle(c, model, q, stick, changed)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     logical, intent(in) :: stick
     integer, intent(out) :: changed
-    logical, intent(out) :: grips
     integer :: released, added
     changed = 0
     if (stick) call friction_update(c, changed)
-    grips = changed > 0
-    if (grips) return
+    if (changed > 0) return
     call contact_release(c, released, keep_stuck=.not. stick)
     call contact_update(c, model, q, .true., added, reproject=.false.)
     changed = released + added
-    if (changed > 0) call remember_set(c%set, c%npairs)
+    if (changed == 0) return
+    c%set%decisions = c%set%decisions + 1
+    call remember_set(c%set, c%npairs)
   end subroutine contact_settle
 
   !> Note the set Newton goes on with; one it had already converged for in this solve is a

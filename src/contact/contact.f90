@@ -130,6 +130,11 @@ module casca_contact
     integer :: nact = 0
     type(constraint_t), allocatable :: act(:)
     integer :: changes = 0                      !< active-set changes in this step
+    !> the releases and new contacts decided in this solve (contact_settle), which Newton
+    !> bounds; stick/slip turns alone are not among them (friction_update turns a node at
+    !> most three times in a solve: counted, a plate at rest on an incline under rho_inf 0.8,
+    !> its nodes slipping and sticking again a batch at a time, ran out of decisions)
+    integer :: decisions = 0
     !> the sets this solve has settled into (active_set.f90's set_key), and whether it came
     !> back to one of them: then tensile constraints go one at a time, and nodes arriving
     !> with a slip Coulomb cannot stop come in sliding

@@ -95,8 +95,6 @@ contains
     integer :: i, j, k, n, p
     character(len=1) :: t, q
     logical :: done
-    character(len=20), allocatable :: seen(:)   !< the keys given so far, and their lines
-    integer, allocatable :: seen_line(:)
     integer :: nval, key_line
     logical :: indexed, comma   !< comma: the last item was a comma
 
@@ -126,7 +124,6 @@ contains
     n = len(s)
     p = index(s, '&') + 1 + len_trim(group)
     key = ''; t = ' '
-    allocate (seen(0), seen_line(0))
     nval = 0; key_line = 0; indexed = .false.; comma = .false.
     done = .false.
     do while (p <= n .and. .not. done)
@@ -245,19 +242,18 @@ contains
     !> thickness lines ran with the second)
     subroutine once()
       integer :: m
-      do m = 1, size(seen)
-        if (seen(m) /= key) cycle
-        if (seen_line(m) == key_line) then
+      do m = 1, size(keys)
+        if (keys(m) /= key) cycle
+        if (key_lines(m) == key_line) then
           call report(key_line, '&'//group//': '//key//' is given twice on this line: keep one')
         else
-          call report(key_line, '&'//group//': '//key//' is given twice (lines '//itoa(seen_line(m))// &
+          call report(key_line, '&'//group//': '//key//' is given twice (lines '//itoa(key_lines(m))// &
                       ' and '//itoa(key_line)//'): keep one')
         end if
         return
       end do
-      seen = [character(len=20) :: seen, key]
-      seen_line = [seen_line, key_line]
-      keys = seen; key_lines = seen_line
+      keys = [character(len=20) :: keys, key]
+      key_lines = [key_lines, key_line]
     end subroutine once
 
     !> The key just read is complete: a vector of three takes three numbers (the read fills

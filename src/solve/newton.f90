@@ -13,10 +13,12 @@
 !> max_iter counts the iterations of one active set: a change starts the count again (a hoop's
 !> contact nodes going from stick to slip one batch per convergence took 20 iterations in all,
 !> and the step was cut although each set converged), and the changes are counted apart, at
-!> most max_set_changes. A change is one decision where the set was judged (set_changed), however
-!> many constraints it moves: new penetrations taken between them belong to the iterations of
-!> the set (counted one each, a plate landing flat and turning, its nodes touching a few at a
-!> time and each batch going from stick to slip at once, had its step cut after four decisions).
+!> most max_set_changes (active_set_t%decisions; stick/slip turns alone are not counted,
+!> friction_update bounds them). A change is one decision where the set was judged
+!> (set_changed), however many constraints it moves: new penetrations taken between them
+!> belong to the iterations of the set (counted one each, a plate landing flat and turning,
+!> its nodes touching a few at a time and each batch going from stick to slip at once, had
+!> its step cut after four decisions).
 !>
 !> With reuse, a factorisation is kept across iterations and steps while each iteration
 !> shrinks the increment fast enough (modified Newton: only the force is assembled then). A
@@ -118,7 +120,6 @@ contains
     type(rows_t) :: rows
     type(increment_t) :: inc
     integer :: it, it_set, nc, version
-    integer :: settles   !< the active-set changes decided in this solve (set_changed)
     integer :: set_start   !< the first increment of the current active set
     integer :: follow_start   !< the iteration after which the sliding directions followed the slip
     real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
@@ -138,7 +139,7 @@ contains
     ffloor = 0
     if (present(cm)) ffloor = inertial_floor(model, cm, opts%tol)
     refresh_next = .false.
-    it_set = 0; set_start = 1; settles = 0
+    it_set = 0; set_start = 1
     do it = 1, max_hist
       it_set = it_set + 1
       if (it_set > opts%max_iter) exit
@@ -174,7 +175,7 @@ contains
       ! (a new rule for the sliding directions: the residual's change is not the increment's)
       if (slip_rule_changed(it, settling(rep, set_start), follow_start, contact)) inc%set = -1
       if (.not. small_enough(rep, step_tol(opts%tol, q, model%length, qn))) then
-        if (near_enough(rep, set_start, settles, contact)) then
+        if (near_enough(rep, set_start, contact)) then
           if (set_changed(stick=.false.)) call new_set()
           if (allocated(err)) exit
         end if
@@ -212,7 +213,7 @@ contains
       version = 0
       call timer_start(t_contact)
       if (present(contact)) then
-        call contact_update(contact, model, q, settles < max_set_changes, added, &
+        call contact_update(contact, model, q, contact%set%decisions < max_set_changes, added, &
                             reproject=reproject)
         nc = contact_newton_nrows(contact)
         if (present(qn) .and. present(af)) call contact_force_points(contact, model, af, q, qn)
@@ -335,18 +336,13 @@ contains
     logical function set_changed(stick)
       logical, intent(in) :: stick
       integer :: changed
-      logical :: grips
       set_changed = .false.
       if (.not. present(contact)) return
       call timer_start(t_contact)
-      call contact_settle(contact, model, q, stick, changed, grips)
+      call contact_settle(contact, model, q, stick, changed)
       call timer_stop(t_contact)
       set_changed = changed > 0
-      ! (stick/slip turns alone are bounded per node and step: a plate at rest on an incline
-      ! under rho_inf 0.8, its nodes slipping and sticking again a batch at a time, ran out of
-      ! decisions; max_hist bounds their iterations)
-      if (set_changed .and. .not. grips) settles = settles + 1
-      if (set_changed .and. settles >= max_set_changes) &
+      if (set_changed .and. contact%set%decisions >= max_set_changes) &
         call fatal_error(err, 'the contact active set did not settle')
     end function set_changed
 
@@ -474,13 +470,13 @@ contains
   !> the rest wait for convergence, where the multipliers' signs are sure (three tubes in a
   !> pile: 18 and 6 constraints in turn, released and taken again from near iterates, until
   !> the step was cut)
-  logical pure function near_enough(rep, set_start, settles, contact)
+  logical pure function near_enough(rep, set_start, contact)
     type(newton_report_t), intent(in) :: rep
-    integer, intent(in) :: set_start, settles   !< settles: the changes decided so far
+    integer, intent(in) :: set_start
     type(contact_t), intent(in), optional :: contact
     near_enough = .false.
     if (.not. present(contact)) return
-    if (settles >= max_set_changes/2) return
+    if (contact%set%decisions >= max_set_changes/2) return
     near_enough = settling(rep, set_start)
   end function near_enough
 
