@@ -41,25 +41,27 @@ contains
     ! active constraints: project again (the target moves and the node slides), or with
     ! reproject = .false. hold the point
     do k = 1, c%set%nact
-      if (c%set%act(k)%grip == 0 .and. friction_on(c, c%set%act(k)%pair)) c%set%act(k)%grip = stick   ! (restart)
-      if (present(reproject) .and. (c%pair(2, c%set%act(k)%pair) <= 0 .or. c%set%act(k)%elem > 0)) then
-        if (.not. reproject) then
-          call constraint_geometry(c, model, x, q, c%set%act(k), normals, lever=.true.); cycle
-        end if
-      end if
-      if (c%pair(2, c%set%act(k)%pair) > 0) then
-        call project(c, model, x, c%set%act(k)%node, c%set%act(k)%pair, cn, found)
-        if (found) then
-          c%set%act(k)%elem = cn%elem; c%set%act(k)%xi = cn%xi; c%set%act(k)%sd = cn%sd
-          if ((cn%side == around_rim) .neqv. (c%set%act(k)%side == around_rim)) then   ! (onto or off a rim)
-            c%set%act(k)%side = cn%side; c%set%act(k)%face(2) = 0
+      associate (a => c%set%act(k))
+        if (a%grip == 0 .and. friction_on(c, a%pair)) a%grip = stick   ! (restart)
+        if (present(reproject) .and. (c%pair(2, a%pair) <= 0 .or. a%elem > 0)) then
+          if (.not. reproject) then
+            call constraint_geometry(c, model, x, q, a, normals, lever=.true.); cycle
           end if
-        else if (c%set%act(k)%elem == 0) then   ! restored from a checkpoint, nothing to press on
-          c%set%act(k)%lambda = 1   ! (released at the next release)
-          cycle
-        end if   ! (else far from every sub-triangle within reach: keep the last point)
-      end if
-      call constraint_geometry(c, model, x, q, c%set%act(k), normals, lever=.true.)
+        end if
+        if (c%pair(2, a%pair) > 0) then
+          call project(c, model, x, a%node, a%pair, cn, found)
+          if (found) then
+            a%elem = cn%elem; a%xi = cn%xi; a%sd = cn%sd
+            if ((cn%side == around_rim) .neqv. (a%side == around_rim)) then   ! (onto or off a rim)
+              a%side = cn%side; a%face(2) = 0
+            end if
+          else if (a%elem == 0) then   ! restored from a checkpoint, nothing to press on
+            a%lambda = 1   ! (released at the next release)
+            cycle
+          end if   ! (else far from every sub-triangle within reach: keep the last point)
+        end if
+        call constraint_geometry(c, model, x, q, a, normals, lever=.true.)
+      end associate
     end do
     if (.not. detect) return
     do ip = 1, c%npairs

@@ -64,29 +64,31 @@ contains
       qf = q
     end if
     do k = 1, c%set%nact
-      call force_point(model, qf, c%set%act(k))
-      bt = c%pair(2, c%set%act(k)%pair)
-      if (bt > 0) then
-        if (c%set%act(k)%nl == 0) cycle
-        ! a normal row with its lever: the gap's gradient at qf (its point, side and faces
-        ! held), the midpoint rule's force for a work that is the gap's change over the step
-        if (.not. allocated(xf)) then
-          xf = positions(model, qf)
-          if (c%opt%nodal_normal) call normal_cache(model, normals)
+      associate (a => c%set%act(k))
+        call force_point(model, qf, a)
+        bt = c%pair(2, a%pair)
+        if (bt > 0) then
+          if (a%nl == 0) cycle
+          ! a normal row with its lever: the gap's gradient at qf (its point, side and faces
+          ! held), the midpoint rule's force for a work that is the gap's change over the step
+          if (.not. allocated(xf)) then
+            xf = positions(model, qf)
+            if (c%opt%nodal_normal) call normal_cache(model, normals)
+          end if
+          cf = a   ! (normals: made and read with nodal normals only)
+          call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
+          if (cf%nl /= a%nl) cycle   ! (the same nodes; else the end's gradient)
+          a%nf = cf%n; a%wgf = cf%wg; a%lgradf = cf%lgrad(:, 1:cf%nl)
+          cycle
         end if
-        cf = c%set%act(k)   ! (normals: made and read with nodal normals only)
-        call constraint_geometry(c, model, xf, qf, cf, normals, lever=.true.)
-        if (cf%nl /= c%set%act(k)%nl) cycle   ! (the same nodes; else the end's gradient)
-        c%set%act(k)%nf = cf%n; c%set%act(k)%wgf = cf%wg; c%set%act(k)%lgradf = cf%lgrad(:, 1:cf%nl)
-        cycle
-      end if
-      ! an obstacle: its normal at the node's face point there (the midpoint rule's
-      ! angular momentum about a cylinder's axis changes by x_mid x f, which n at the step's
-      ! end, half a step's slide away, did not leave at zero: a ring spinning in a drum lost
-      ! 1.4e-4 of it at 10 us, first order in dt)
-      nd = c%set%act(k)%node
-      call obstacle_point(c%obstacle(-bt), c%time, qf(dof(nd, 1):dof(nd, 3)) + &
-                          c%set%act(k)%wg(1)*qf(dof(nd, 4):dof(nd, 6)), c%set%act(k)%nf, gm)
+        ! an obstacle: its normal at the node's face point there (the midpoint rule's
+        ! angular momentum about a cylinder's axis changes by x_mid x f, which n at the step's
+        ! end, half a step's slide away, did not leave at zero: a ring spinning in a drum lost
+        ! 1.4e-4 of it at 10 us, first order in dt)
+        nd = a%node
+        call obstacle_point(c%obstacle(-bt), c%time, qf(dof(nd, 1):dof(nd, 3)) + &
+                            a%wg(1)*qf(dof(nd, 4):dof(nd, 6)), a%nf, gm)
+      end associate
     end do
   end subroutine contact_force_points
 
@@ -99,12 +101,14 @@ contains
     allocate (lam(contact_newton_nrows(c)))
     r = 0
     do k = 1, c%set%nact
-      r = r + 1; lam(r) = c%set%act(k)%lambda
-      if (c%set%act(k)%grip == stick) then
-        lam(r + 1:r + 2) = c%set%act(k)%lt; r = r + 2
-      else if (c%set%act(k)%grip == slip) then
-        r = r + 1; lam(r) = 0
-      end if
+      associate (a => c%set%act(k))
+        r = r + 1; lam(r) = a%lambda
+        if (a%grip == stick) then
+          lam(r + 1:r + 2) = a%lt; r = r + 2
+        else if (a%grip == slip) then
+          r = r + 1; lam(r) = 0
+        end if
+      end associate
     end do
   end function contact_multipliers
 
@@ -114,12 +118,14 @@ contains
     integer :: k, r
     r = 0
     do k = 1, c%set%nact
-      r = r + 1; c%set%act(k)%lambda = lam(r)
-      if (c%set%act(k)%grip == stick) then
-        c%set%act(k)%lt = lam(r + 1:r + 2); r = r + 2
-      else if (c%set%act(k)%grip == slip) then
-        r = r + 1
-      end if
+      associate (a => c%set%act(k))
+        r = r + 1; a%lambda = lam(r)
+        if (a%grip == stick) then
+          a%lt = lam(r + 1:r + 2); r = r + 2
+        else if (a%grip == slip) then
+          r = r + 1
+        end if
+      end associate
     end do
   end subroutine contact_set_multipliers
 
@@ -153,46 +159,48 @@ contains
     allocate (irn(m), jcn(m), val(m), gap(nr), key(2, nr), fval(m))
     m = 0; r = 0
     do k = 1, c%set%nact
-      do i = 0, constraint_nkinds(c%set%act(k)) - merge(0, 1, c%set%act(k)%grip == slip)
-        kind = i
-        if (c%set%act(k)%grip == slip .and. i == 1) kind = across
-        r = r + 1
-        if (kind == 0) then   ! (compliant: g - lambda / k, contact_set_stiffness)
-          gap(r) = normal_residual(c, c%set%act(k))
-        else if (kind == across) then
-          gap(r) = 0
-        else
-          gap(r) = c%set%act(k)%gt(kind)
-        end if
-        key(:, r) = [4*c%set%act(k)%node + kind, c%set%act(k)%elem]
-        if (kind == across) key(1, r) = -(4*c%set%act(k)%node + 3)   ! (apart from every other row)
-        call constraint_row(c%set%act(k), model, d, v, nd, kind)
-        vf(1:nd) = v(1:nd)   ! (the force's own row only where it has its own point)
-        if (any(c%set%act(k)%shpf /= c%set%act(k)%shp) .or. any(c%set%act(k)%nf /= c%set%act(k)%n) .or. &
-            c%set%act(k)%nl > 0) &
-          call constraint_row(c%set%act(k), model, d, vf, nd, kind, force=.true.)
-        mu = 0; ns = 0
-        if (kind == 0 .and. c%set%act(k)%grip == slip .and. c%set%act(k)%lambda < 0) then
-          mu = sliding_coefficient(c, c%set%act(k)); key(1, r) = 4*c%set%act(k)%node + 3
-          call constraint_row(c%set%act(k), model, d, vs, ns, 3, force=.true.)   ! (the same points first)
-        end if
-        w = 1   ! (the row's weight: 0 for an empty row across a held s)
-        if (kind == across) then
-          ks = slip_stiffness(c, c%set%act(k))
-          if (.not. ks > 0) w = 0
-        end if
-        do j = 1, nd
-          if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
-          m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = w*v(j); fval(m) = w*vf(j)
-          if (j <= ns) fval(m) = vf(j) - mu*vs(j)
+      associate (a => c%set%act(k))
+        do i = 0, constraint_nkinds(a) - merge(0, 1, a%grip == slip)
+          kind = i
+          if (a%grip == slip .and. i == 1) kind = across
+          r = r + 1
+          if (kind == 0) then   ! (compliant: g - lambda / k, contact_set_stiffness)
+            gap(r) = normal_residual(c, a)
+          else if (kind == across) then
+            gap(r) = 0
+          else
+            gap(r) = a%gt(kind)
+          end if
+          key(:, r) = [4*a%node + kind, a%elem]
+          if (kind == across) key(1, r) = -(4*a%node + 3)   ! (apart from every other row)
+          call constraint_row(a, model, d, v, nd, kind)
+          vf(1:nd) = v(1:nd)   ! (the force's own row only where it has its own point)
+          if (any(a%shpf /= a%shp) .or. any(a%nf /= a%n) .or. &
+              a%nl > 0) &
+            call constraint_row(a, model, d, vf, nd, kind, force=.true.)
+          mu = 0; ns = 0
+          if (kind == 0 .and. a%grip == slip .and. a%lambda < 0) then
+            mu = sliding_coefficient(c, a); key(1, r) = 4*a%node + 3
+            call constraint_row(a, model, d, vs, ns, 3, force=.true.)   ! (the same points first)
+          end if
+          w = 1   ! (the row's weight: 0 for an empty row across a held s)
+          if (kind == across) then
+            ks = slip_stiffness(c, a)
+            if (.not. ks > 0) w = 0
+          end if
+          do j = 1, nd
+            if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
+            m = m + 1; irn(m) = neq + r; jcn(m) = eq(d(j)); val(m) = w*v(j); fval(m) = w*vf(j)
+            if (j <= ns) fval(m) = vf(j) - mu*vs(j)
+          end do
+          m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
+          if (kind == 0) val(m) = -normal_compliance(c, a)
+          if (kind == across) then
+            val(m) = -1
+            if (w > 0) val(m) = -1/ks
+          end if
         end do
-        m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
-        if (kind == 0) val(m) = -normal_compliance(c, c%set%act(k))
-        if (kind == across) then
-          val(m) = -1
-          if (w > 0) val(m) = -1/ks
-        end if
-      end do
+      end associate
     end do
     irn = irn(1:m); jcn = jcn(1:m); val = val(1:m); fval = fval(1:m)
   end subroutine contact_rows
@@ -274,8 +282,10 @@ contains
     integer :: k
     contact_max_gap = 0
     do k = 1, c%set%nact
-      contact_max_gap = max(contact_max_gap, abs(normal_residual(c, c%set%act(k))))
-      if (c%set%act(k)%grip == stick) contact_max_gap = max(contact_max_gap, maxval(abs(c%set%act(k)%gt)))
+      associate (a => c%set%act(k))
+        contact_max_gap = max(contact_max_gap, abs(normal_residual(c, a)))
+        if (a%grip == stick) contact_max_gap = max(contact_max_gap, maxval(abs(a%gt)))
+      end associate
     end do
   end function contact_max_gap
 
@@ -300,7 +310,9 @@ contains
     integer :: k
     f = 0
     do k = 1, c%set%nact
-      f(:, c%set%act(k)%pair) = f(:, c%set%act(k)%pair) + node_force(c, c%set%act(k))
+      associate (a => c%set%act(k))
+        f(:, a%pair) = f(:, a%pair) + node_force(c, a)
+      end associate
     end do
   end function pair_forces
 

@@ -109,12 +109,11 @@ contains
       ! direction; then the work summed so far (friction per pair, moving obstacles); last
       ! per pair the impulse so far and the start force of the next step (rows.f90); last
       ! friction's start force per constraint (friction.f90).
-      ints = [level, nact, (contact%set%act(k)%node, contact%set%act(k)%pair, contact%set%act(k)%elem, &
-                            contact%set%act(k)%side, contact%set%act(k)%face, contact%set%act(k)%grip, k=1, nact)]
-      reals = [contact%set%act(1:nact)%lambda, contact%set%act(1:nact)%mu, &
-               (contact%set%act(k)%xi, contact%set%act(k)%lt, contact%set%act(k)%mut, contact%set%act(k)%s, &
-                k=1, nact), contact%friction_work, contact%obstacle_work, &
-               contact%impulse, contact%carry, (contact%set%act(k)%fa, k=1, nact), contact%set%act(1:nact)%hold]
+      associate (a => contact%set%act(1:nact))
+        ints = [level, nact, (a(k)%node, a(k)%pair, a(k)%elem, a(k)%side, a(k)%face, a(k)%grip, k=1, nact)]
+        reals = [a%lambda, a%mu, (a(k)%xi, a(k)%lt, a(k)%mut, a(k)%s, k=1, nact), contact%friction_work, &
+                 contact%obstacle_work, contact%impulse, contact%carry, (a(k)%fa, k=1, nact), a%hold]
+      end associate
     else
       ints = [level, 0]
       allocate (reals(0))
@@ -289,27 +288,29 @@ contains
     with_hold = size(reals) == 15*int(nact, int64) + 7*contact%npairs + 1   ! (the depths held)
     do k = 1, nact
       contact%set%act(k) = new_constraint(ints(3 + per*(k - 1)), ints(4 + per*(k - 1)))
-      contact%set%act(k)%lambda = reals(k)   ! the multipliers start each step from the last
-      if (per == 2) cycle   ! (elem = 0: projected again at the first step)
-      contact%set%act(k)%elem = ints(5 + per*(k - 1))
-      contact%set%act(k)%side = ints(6 + per*(k - 1))
-      contact%set%act(k)%face = ints(7 + per*(k - 1):8 + per*(k - 1))
-      contact%set%act(k)%grip = ints(9 + per*(k - 1))
-      contact%set%act(k)%mu = reals(nact + k)
-      associate (r => reals(2*nact + 9*k - 8:2*nact + 9*k))
-        contact%set%act(k)%xi = r(1:2); contact%set%act(k)%lt = r(3:4); contact%set%act(k)%mut = r(5:6)
-        contact%set%act(k)%s = r(7:9)
-      end associate
-      if (with_fa) then
-        associate (at => 11*nact + 7*contact%npairs + 1 + 3*(k - 1))
-          contact%set%act(k)%fa = reals(at + 1:at + 3)
+      associate (a => contact%set%act(k))
+        a%lambda = reals(k)   ! the multipliers start each step from the last
+        if (per == 2) cycle   ! (elem = 0: projected again at the first step)
+        a%elem = ints(5 + per*(k - 1))
+        a%side = ints(6 + per*(k - 1))
+        a%face = ints(7 + per*(k - 1):8 + per*(k - 1))
+        a%grip = ints(9 + per*(k - 1))
+        a%mu = reals(nact + k)
+        associate (r => reals(2*nact + 9*k - 8:2*nact + 9*k))
+          a%xi = r(1:2); a%lt = r(3:4); a%mut = r(5:6)
+          a%s = r(7:9)
         end associate
-      end if
-      if (with_hold) contact%set%act(k)%hold = reals(14*nact + 7*contact%npairs + 1 + k)
-      ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
-      ! that wrote it left them
-      if (contact%set%act(k)%elem > 0 .or. contact%pair(2, contact%set%act(k)%pair) <= 0) &
-        call constraint_geometry(contact, model, positions(model, st%q), st%q, contact%set%act(k), lever=.true.)
+        if (with_fa) then
+          associate (at => 11*nact + 7*contact%npairs + 1 + 3*(k - 1))
+            a%fa = reals(at + 1:at + 3)
+          end associate
+        end if
+        if (with_hold) a%hold = reals(14*nact + 7*contact%npairs + 1 + k)
+        ! normal, shape functions, offset and gap at the checkpoint's positions, as the step
+        ! that wrote it left them
+        if (a%elem > 0 .or. contact%pair(2, a%pair) <= 0) &
+          call constraint_geometry(contact, model, positions(model, st%q), st%q, a, lever=.true.)
+      end associate
     end do
   contains
     !> the checksum of what was read (the pressure work with the reals, as save_checkpoint)
