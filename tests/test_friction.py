@@ -25,6 +25,10 @@ own        the same push with the obstacle's own friction = 0.8 alone and &conta
 pair       the block thrown at 1 m/s onto a meshed, fixed steel plate (friction between bodies)
            with &contact friction = 0.6 but pair_friction = 0.25 for (block, plate): it
            decelerates at 0.25 g (1%).
+floors     two such blocks, 0.5 m apart, each on its own floor (`&obstacle bodies`), mu 0.3 and
+           0.15, thrown at 1 and 0.6 m/s: each pair's friction work in the history
+           (friction_work_block_floor_a, friction_work_block2_floor_b) equals its block's
+           kinetic energy lost, 1/2 m v0^2, when it has stopped (1%).
 A steel hoop (R 0.2 m, h 40 mm, width 50 mm, 40 elements) resting on the plane is thrown
 sliding at v0 = 2 m/s without spin, mu = 0.3: friction decelerates it and spins it up until
 it rolls on its outer face (radius Rc = R + h/2, where the friction acts and the contact point
@@ -239,6 +243,22 @@ if h is not None:
     v, t = np.sqrt(2 * h["kinetic_block"] / m_block), h["t"]
     i0, i1 = np.argmin(abs(t - 0.1)), np.argmin(abs(t - 0.25))
     ck.close("pair: deceleration [m/s^2] vs 0.25 g", (v[i0] - v[i1]) / (t[i1] - t[i0]), 0.25 * G, 0.01)
+
+h, _ = go("floors", f"""&run dt = 1.0e-3, t_end = 0.5, gravity = 0.0, 0.0, {-G} /
+&output vtu = .false., plots = .false. /
+&body name = 'block', mesh = 'file', file = '{block}', center = 0.0, 0.0, 0.01,
+  velocity = 1.0, 0.0, 0.0, {STEEL}, thickness = 0.02 /
+&body name = 'block2', mesh = 'file', file = '{block}', center = 0.0, 0.5, 0.01,
+  velocity = 0.6, 0.0, 0.0, {STEEL}, thickness = 0.02 /
+&obstacle name = 'floor_a', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0,
+  bodies = 'block', friction = 0.3 /
+&obstacle name = 'floor_b', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0,
+  bodies = 'block2', friction = 0.15 /
+""")
+if h is not None:
+    for b, f, v0 in (("block", "floor_a", 1.0), ("block2", "floor_b", 0.6)):
+        ck.close("floors: friction work of pair %s, %s [J] vs 1/2 m v0^2" % (b, f),
+                 h["friction_work_%s_%s" % (b, f)][-1], 0.5 * m_block * v0**2, 0.01)
 
 # --- the hoop
 R, H, W, V0 = 0.2, 0.04, 0.05, 2.0

@@ -16,7 +16,7 @@ module casca_contact_rows
   private
   public :: contact_nrows, contact_newton_nrows, contact_rows, contact_multipliers, contact_set_multipliers
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
-  public :: contact_stored_energy
+  public :: pair_stored_energy
   public :: constraint_nkinds, slip_force, friction_force, add_step_impulse, pair_forces, contact_force_points
   public :: start_carry
 
@@ -289,19 +289,19 @@ contains
     end do
   end function contact_max_gap
 
-  !> The energy a compliant contact holds at its gaps, k g^2 / 2 over the penetrating active
-  !> constraints [J] (as the strain energy, at the step's end)
-  pure real(dp) function contact_stored_energy(c)
+  !> Per pair, the energy a compliant contact holds at its gaps, k g^2 / 2 over the
+  !> penetrating active constraints [J] (as the strain energy, at the step's end)
+  pure function pair_stored_energy(c) result(e)
     type(contact_t), intent(in) :: c
+    real(dp) :: e(c%npairs)
     integer :: k
-    contact_stored_energy = 0
+    e = 0
     do k = 1, c%set%nact
       associate (a => c%set%act(k))
-        if (c%opt%compliance(a%node) > 0) contact_stored_energy = contact_stored_energy + &
-                                                              0.5_dp*min(a%gap, 0._dp)**2/c%opt%compliance(a%node)
+        if (c%opt%compliance(a%node) > 0) e(a%pair) = e(a%pair) + 0.5_dp*min(a%gap, 0._dp)**2/c%opt%compliance(a%node)
       end associate
     end do
-  end function contact_stored_energy
+  end function pair_stored_energy
 
   !> The contact force on each pair's impactor (3, npairs): normal and friction
   pure function pair_forces(c) result(f)

@@ -26,7 +26,7 @@ module casca_run
   use casca_mesh_indicator, only: indicator_line_len
   use casca_contact, only: contact_t
   use casca_contact_active_set, only: contact_update
-  use casca_contact_rows, only: contact_force_total, contact_nodal_fields, contact_stored_energy, start_carry
+  use casca_contact_rows, only: contact_force_total, contact_nodal_fields, pair_stored_energy, start_carry
   use casca_contact_probes, only: contact_penetration, contact_signed_distance
   use casca_pair_report, only: pair_normal_force, pair_active_count, pair_labels
   use casca_contact_friction, only: pair_tangential_force
@@ -802,17 +802,18 @@ contains
     type(run_t), intent(inout) :: r
     character(len=64), allocatable :: body_names(:), sides(:)   ! (the deck's longest name)
     character(len=:), allocatable :: pair_names(:)
-    logical :: friction
+    logical :: friction, compliant
     integer :: k, no
     associate (deck => r%deck, model => r%model)
       allocate (body_names(model%nbody))
       do k = 1, model%nbody
         body_names(k) = model%body(k)%name
       end do
-      friction = .false.
+      friction = .false.; compliant = .false.
       allocate (character(len=1) :: pair_names(0))
       if (allocated(r%contact)) then
         friction = any(r%contact%mu_d > 0) .or. any(r%contact%mu_s > 0)
+        compliant = r%contact%opt%compliant
         no = size(deck%obstacles)
         allocate (sides(no + 1 + model%nbody))   ! (sides -no .. nbody)
         do k = 1, no
@@ -823,8 +824,8 @@ contains
         call pair_labels(r%contact%pair, sides, -no, pair_names)
       end if
       call output_open(r%out, r%dir, r%tracked, r%labels, body_names, pair_names, friction, &
-                       moving_obstacles(deck, allocated(r%contact)), r%restart_step, r%st%t, r%err, &
-                       folder_of(r%restart))
+                       moving_obstacles(deck, allocated(r%contact)), compliant, r%restart_step, r%st%t, &
+                       r%err, folder_of(r%restart))
     end associate
   end subroutine open_history
 
@@ -840,7 +841,7 @@ contains
         call output_history(r%out, r%st, r%bal, c%set%nact, contact_force_total(c), newton, &
                             max(pen, 0._dp), r%rep%neg_pivots, lmax, gmax, &
                             pair_normal_force(c), pair_active_count(c), norm2(c%impulse, dim=1), r%err, &
-                            pair_tangential_force(c), sum(c%friction_work), c%obstacle_work)
+                            pair_tangential_force(c), c%friction_work, c%obstacle_work, pair_stored_energy(c))
       end associate
     else
       call output_history(r%out, r%st, r%bal, 0, 0._dp, newton, 0._dp, r%rep%neg_pivots, 0._dp, 0._dp, &
@@ -1064,7 +1065,7 @@ contains
     else
       call account(r%model, r%asm, r%st, r%fext, r%q0, r%bal)
     end if
-    if (allocated(r%contact)) r%bal%total = r%bal%total + contact_stored_energy(r%contact)
+    if (allocated(r%contact)) r%bal%total = r%bal%total + sum(pair_stored_energy(r%contact))
   end subroutine account_state
 
   !> energy_balance's remainder at the run's state: E0 less what the bodies hold and the
@@ -1148,7 +1149,7 @@ contains
       terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work, &
                                                           source=.true.)]
     if (contact%opt%compliant) terms = [terms, energy_term_t('held in the contact stiffness', &
-                                                         contact_stored_energy(contact))]
+                                                         sum(pair_stored_energy(contact)))]
   end function balance_terms
 
   logical function moving_obstacles(deck, use_contact)

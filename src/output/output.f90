@@ -48,6 +48,7 @@ module casca_output
     integer :: nbody = 0, npairs = 0    !< per-body and per-pair columns
     logical :: friction = .false.       !< the pairs' tangential forces and the friction work too
     logical :: moving = .false.         !< the work of moving obstacles too
+    logical :: compliant = .false.      !< the energy each pair's compliant contact holds too
     integer :: rows = 0
     logical :: locked = .false.         !< this run holds the folder's lock
     type(indicator_t) :: ind            !< the mesh indicator of the last frame ...
@@ -65,11 +66,13 @@ contains
   !> their positions. Names are single words of letters, digits and '_' (anything else in a
   !> body's name becomes '_'), which numpy's genfromtxt(names=True) keeps as they are.
   !> With friction, then ftangent_P per pair and friction_work (dissipated by sliding); with
-  !> moving obstacles, obstacle_work (done on the bodies).
-  function history_columns(ntrack, bodies, pairs, friction, moving) result(cols)
+  !> moving obstacles, obstacle_work (done on the bodies); then, each after all the above so
+  !> that they keep their positions, with friction friction_work_P per pair and with a
+  !> compliant contact contact_energy_P per pair (what its compliance holds).
+  function history_columns(ntrack, bodies, pairs, friction, moving, compliant) result(cols)
     integer, intent(in) :: ntrack
     character(len=*), intent(in) :: bodies(:), pairs(:)
-    logical, intent(in) :: friction, moving
+    logical, intent(in) :: friction, moving, compliant
     character(len=col_len), allocatable :: cols(:)
     character(len=*), parameter :: suffix(6) = [character(len=3) :: '_x', '_y', '_z', '_vx', '_vy', '_vz']
     character(len=8) :: p
@@ -91,6 +94,8 @@ contains
     if (friction) cols = [cols, (word('ftangent_'//trim(pairs(k))), k=1, size(pairs)), &
                           word('friction_work')]
     if (moving) cols = [cols, word('obstacle_work')]
+    if (friction) cols = [cols, (word('friction_work_'//trim(pairs(k))), k=1, size(pairs))]
+    if (compliant) cols = [cols, (word('contact_energy_'//trim(pairs(k))), k=1, size(pairs))]
   contains
     pure function word(name) result(w)
       character(len=*), intent(in) :: name
@@ -102,10 +107,10 @@ contains
   !> Create the folder, lock it (casca_output_lock) and make the files; with restart_step >= 0
   !> keep what an earlier run wrote up to that step (and the frames up to restart_time) and
   !> append after it. bodies: the bodies' names; pairs: a label per contact pair.
-  subroutine output_open(out, dir, tracked, labels, bodies, pairs, friction, moving, restart_step, &
-                         restart_time, err, restart_dir)
+  subroutine output_open(out, dir, tracked, labels, bodies, pairs, friction, moving, compliant, &
+                         restart_step, restart_time, err, restart_dir)
     type(output_t), intent(out) :: out
-    logical, intent(in) :: friction, moving
+    logical, intent(in) :: friction, moving, compliant
     character(len=*), intent(in) :: dir
     integer, intent(in) :: tracked(:)
     character(len=*), intent(in) :: labels(:), bodies(:), pairs(:)
@@ -122,6 +127,7 @@ contains
     out%dir = trim(dir)
     out%tracked = tracked
     out%nbody = size(bodies); out%npairs = size(pairs); out%friction = friction; out%moving = moving
+    out%compliant = compliant
     allocate (out%files(0), out%times(0))
     if (.not. is_root()) return
     if (.not. make_dir(out%dir)) then
@@ -134,7 +140,7 @@ contains
     call delete_file(out%dir//'/'//stopped_name)   ! (an earlier run's)
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
-    cols = history_columns(size(tracked), bodies, pairs, friction, moving)
+    cols = history_columns(size(tracked), bodies, pairs, friction, moving, compliant)
     ! a restart carries on the checkpoint folder's history, and into another folder leaves
     ! its frames there: what the other folder held is not taken (another run's rows were kept
     ! as this run's) unless the checkpoint's folder has no history (a checkpoint copied away
@@ -291,7 +297,7 @@ contains
   !> constraints per contact pair (pair_force, pair_count: as many as output_open's pairs).
   subroutine output_history(out, st, bal, contacts, fcontact, newton, penetration, neg_pivots, &
                             lambda_max, gap_max, pair_force, pair_count, pair_impulse, err, pair_tangent, &
-                            friction_work, obstacle_work)
+                            pair_friction_work, obstacle_work, pair_energy)
     type(output_t), intent(inout) :: out
     type(state_t), intent(in) :: st
     type(balance_t), intent(in) :: bal
@@ -300,7 +306,8 @@ contains
     real(dp), intent(in) :: pair_force(:), pair_impulse(:)
     integer, intent(in) :: pair_count(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), intent(in), optional :: pair_tangent(:), friction_work, obstacle_work
+    !> per pair: the friction force's magnitude, the work sliding dissipated, the compliance's energy
+    real(dp), intent(in), optional :: pair_tangent(:), pair_friction_work(:), obstacle_work, pair_energy(:)
     real(dp), allocatable :: row(:)
     character(len=max_line) :: line
     integer :: k, n
@@ -320,8 +327,10 @@ contains
       return
     end if
     row = [row, bal%body_kinetic, bal%body_strain, pair_force, real(pair_count, dp), pair_impulse]
-    if (out%friction) row = [row, pair_tangent, friction_work]
+    if (out%friction) row = [row, pair_tangent, sum(pair_friction_work)]
     if (out%moving) row = [row, obstacle_work]
+    if (out%friction) row = [row, pair_friction_work]
+    if (out%compliant) row = [row, pair_energy]
     write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
     call cf_write(out%hist, trim(line)//new_line('a'), err)
     ! (each row to the system whole: a killed run's history.dat ends with a whole row, and a
