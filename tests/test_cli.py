@@ -244,6 +244,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["&run is closed with &end (line 3)", ":1:"]),
     ("names making one history column", lambda s: s.replace("'ring1'", "'ring 1'").replace("'ring2'", "'ring_1'"),
      ["name 'ring_1' and 'ring 1' make the same history column name 'ring_1'", ":15:"]),
+    ("a thickness in another unit", lambda s: s.replace("thickness = 0.05", "thickness = 1.5", 1),
+     ["&body ring1: thickness 1.5000E+00 m is more than half the body's size, 2.0000E+00 m", ":12:"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),
     ("missing required value", lambda s: s.replace("young = 210e9, ", "", 1), ["young", "missing"]),

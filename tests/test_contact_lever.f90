@@ -9,7 +9,10 @@
 !> is of the row's own size (0.77 with nodal normals, 1.01 with element normals: the old
 !> row, checked here with its lever left out, nl = 0). The force row has no net force and
 !> no moment about the origin at the midpoint (positions and fibres), to 1e-10 of the
-!> row's size. Nodal normals (the default) and element normals.
+!> row's size. Nodal normals (the default) and element normals. The blade's rim nodes lie in
+!> the offset's fade band: there the gap's second derivative along n on the node's fibre,
+!> -wgg (Newton's bend row, contact_rows), equals central second differences within 1e-4 of
+!> its largest value (at least 4 such nodes).
 !> Second scene: a plate (h 10 mm, 4 x 4 cells, tilted 30 degrees) pressed 2 mm into the
 !> top edge of a band standing on its rim (one pass: the plate's nodes are the impactor),
 !> so that its nodes meet the band's rounded edge (around_rim): the same checks, the row
@@ -146,6 +149,7 @@ contains
     end do
     call check_true(label//': every constraint has its lever', all(c%set%act(1:c%set%nact)%nl >= 10))
     call check_le(label//': gap row against finite differences', e_gap, 1e-6_dp)
+    if (label /= 'rim') call check_curvature(c, label)
     call check_le(label//': (without the lever, the error is large) 1 /', 1/e_old, 10._dp)
     ! the force's rows at the midpoint of q and qn
     call contact_force_points(c, model, 0.5_dp, qn, q)
@@ -158,6 +162,35 @@ contains
     call check_le(label//': force row at the midpoint against finite differences', e_force, 1e-6_dp)
     call check_le(label//': force row: net force and moment at the midpoint', mom, 1e-10_dp)
   end subroutine check_rows
+
+  !> The blade's rim nodes in the offset's fade band: the gap's second derivative along n on
+  !> the node's fibre, -wgg (the bend row's stiffness over -lambda), against central second
+  !> differences (step 1e-5 on the fibre: truncation and round-off below 1e-6 of wgg)
+  subroutine check_curvature(c, label)
+    type(contact_t), intent(in) :: c
+    character(len=*), intent(in) :: label
+    real(dp), parameter :: h = 1e-5_dp
+    real(dp), allocatable :: qp(:)
+    real(dp) :: fd, e, scale
+    integer :: k, nband, n
+    e = 0; scale = 0; nband = 0
+    do k = 1, c%set%nact
+      associate (a => c%set%act(k))
+        if (a%wgg == 0) cycle
+        nband = nband + 1
+        n = a%node
+        qp = q
+        qp(dof(n, 4):dof(n, 6)) = q(dof(n, 4):dof(n, 6)) + h*a%n
+        fd = gap_at(c, a, qp)
+        qp(dof(n, 4):dof(n, 6)) = q(dof(n, 4):dof(n, 6)) - h*a%n
+        fd = (fd - 2*gap_at(c, a, q) + gap_at(c, a, qp))/h**2
+        e = max(e, abs(fd + a%wgg)); scale = max(scale, abs(a%wgg))
+      end associate
+    end do
+    call check_true(label//': rim nodes in the fade band ('//itoa(nband)//')', nband >= 4)
+    if (nband > 0) call check_le(label//': the offset''s curvature on the fibre against second differences', &
+                                 e/scale, 1e-4_dp)
+  end subroutine check_curvature
 
   !> largest |row - finite difference| over the largest |finite difference| of con's gap at qa
   real(dp) function row_error(c, con, qa, force) result(err)

@@ -53,6 +53,11 @@ module casca_contact
     real(dp) :: off = 0         !< faces' offset (0 between mid-surfaces)
     !> the gap's derivative on the fibres: wg(1) n.dG at the node, wg(2) sum_j N_j n.dG_j
     real(dp) :: wg(2) = 0
+    !> the gap's second derivative on the impactor node's fibre, -wgg n n^T: nonzero where a
+    !> rim node's offset fades (projection.f90, face); with -lambda it is Newton's stiffness
+    !> along n on that fibre (contact_rows' bend row)
+    real(dp) :: wgg = 0
+    logical :: bend = .false.   !< with a bend row in Newton's system (contact_update decides)
     !> between faces, the gap's derivative through the target normal's turn, D . dn/dx_a
     !> (projection.f90, normal_lever) on the positions of the nodes lnode(1:nl) that n
     !> depends on: lgrad for the gap's row, lgradf (with wgf, the fibres' weights) for the

@@ -173,12 +173,12 @@ contains
     integer :: j, nd, bi, bt, nlv, ln(max_lever)
     logical :: rim
     bi = c%pair(1, con%pair); bt = c%pair(2, con%pair)
-    con%off = 0; con%wg = 0; con%nl = 0
+    con%off = 0; con%wg = 0; con%wgg = 0; con%nl = 0
     if (bt <= 0) then
       con%elem = 0; con%side = 1; con%shp = 0
       call obstacle_point(c%obstacle(-bt), c%time, x(:, con%node), con%n, gm)
       if (c%opt%faces) call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), &
-                             -con%n, con%face(1), con%off, con%wg(1), c%rim(con%node))
+                             -con%n, con%face(1), con%off, con%wg(1), c%rim(con%node), con%wgg)
       con%gap = gm - con%off - con%hold
       call hold_force_point(con)
       call friction_geometry()
@@ -222,7 +222,7 @@ contains
       ! of n's turn: 18% in a step)
       if (rim) con%face(1) = 0
       call face(model%body(bi)%thickness, q(dof(con%node, 4):dof(con%node, 6)), -con%n, con%face(1), &
-                con%off, con%wg(1), c%rim(con%node))
+                con%off, con%wg(1), c%rim(con%node), con%wgg)
       if (rim) then   ! (its edge rounded: h/2 all round, as beside it; no moment on its fibres)
         ft = 0.5_dp*model%body(bt)%thickness; con%wg(2) = 0
       else
@@ -311,27 +311,34 @@ contains
   !> has no mass and follows the contact force within a step, and fed back through the
   !> offset it made the trapezoidal rule unstable: a ring on a floor had a grow from 3e-4 to
   !> 9e-2 in ten steps.)
-  pure subroutine face(h, g, u, s, f, w, rim)
+  pure subroutine face(h, g, u, s, f, w, rim, w2)
     real(dp), intent(in) :: h, g(3), u(3)
     integer, intent(inout) :: s
     real(dp), intent(out) :: f, w
     logical, intent(in), optional :: rim
+    real(dp), intent(out), optional :: w2   !< f's second derivative along u.dG
     real(dp), parameter :: r1 = 0.25_dp, r2 = 0.5_dp
-    real(dp) :: k, r, t, phi, dphi
+    real(dp) :: k, r, t, phi, dphi, ddphi
     logical :: edge_ok
     edge_ok = .true.
     if (present(rim)) edge_ok = rim
     k = dot_product(g, u)
     if (s == 0 .or. s == 2) s = merge(1, -1, k >= 0)   ! (2: an edge, in older checkpoints)
-    phi = 1; dphi = 0
+    phi = 1; dphi = 0; ddphi = 0
     if (edge_ok) then
       r = abs(k)
       t = min(1._dp, max(0._dp, (r - r1)/(r2 - r1)))
+      ! (no offset here, whichever face: a fibre turning through edge-on takes the face
+      ! towards u, held, it measured from the far face past it and let the near one in)
+      if (t == 0) s = merge(1, -1, k >= 0)
       phi = t*t*(3 - 2*t)
       dphi = r*6*t*(1 - t)/(r2 - r1)   ! r phi'(r): d(k phi(|k|))/dk = phi + r phi'
+      ! d2(k phi(|k|))/dk2 = sign(k) (2 phi' + r phi''), inside the band only
+      if (t > 0 .and. t < 1) ddphi = sign(1._dp, k)*(12*t*(1 - t)/(r2 - r1) + r*6*(1 - 2*t)/(r2 - r1)**2)
     end if
     f = 0.5_dp*h*s*k*phi
     w = 0.5_dp*h*s*(phi + dphi)
+    if (present(w2)) w2 = 0.5_dp*h*s*ddphi
   end subroutine face
 
   !> The nodes a constraint acts on and the weights of its row of C: n on the impactor node,

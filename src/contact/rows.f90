@@ -35,11 +35,12 @@ contains
     contact_nrows = sum([(constraint_nkinds(c%set%act(k)), k=1, c%set%nact)])
   end function contact_nrows
 
-  !> Number of rows of Newton's system: the active set's, and one across the slip of each
-  !> sliding constraint (contact_rows)
+  !> Number of rows of Newton's system: the active set's, one across the slip of each
+  !> sliding constraint and one along n on each rim fibre that may bend (contact_rows)
   pure integer function contact_newton_nrows(c)
     type(contact_t), intent(in) :: c
-    contact_newton_nrows = contact_nrows(c) + count(c%set%act(1:c%set%nact)%grip == slip)
+    contact_newton_nrows = contact_nrows(c) + count(c%set%act(1:c%set%nact)%grip == slip) + &
+                           count(c%set%act(1:c%set%nact)%bend)
   end function contact_newton_nrows
 
   !> Every active constraint's force point (force_point) where the scheme takes the
@@ -108,6 +109,9 @@ contains
         else if (a%grip == slip) then
           r = r + 1; lam(r) = 0
         end if
+        if (a%bend) then
+          r = r + 1; lam(r) = 0
+        end if
       end associate
     end do
   end function contact_multipliers
@@ -125,6 +129,7 @@ contains
         else if (a%grip == slip) then
           r = r + 1
         end if
+        if (a%bend) r = r + 1
       end associate
     end do
   end subroutine contact_set_multipliers
@@ -150,12 +155,12 @@ contains
     integer, allocatable, intent(out) :: irn(:), jcn(:), key(:, :)
     real(dp), allocatable, intent(out) :: val(:), gap(:), fval(:)
     integer :: k, j, m, nd, d(max_row), r, kind, nr, ns, i
-    real(dp) :: v(max_row), vs(max_row), vf(max_row), mu, ks, w
+    real(dp) :: v(max_row), vs(max_row), vf(max_row), mu, ks, w, kb
     nr = contact_newton_nrows(c)
     ! (entries: 66 for the points and fibres and a diagonal per row, one more row across a
     ! slip, the levers' beside)
-    m = sum([(67*(constraint_nkinds(c%set%act(k)) + merge(1, 0, c%set%act(k)%grip == slip)) + 3*c%set%act(k)%nl, &
-              k=1, c%set%nact)])
+    m = sum([(67*(constraint_nkinds(c%set%act(k)) + merge(1, 0, c%set%act(k)%grip == slip)) + 3*c%set%act(k)%nl &
+              + merge(4, 0, c%set%act(k)%bend), k=1, c%set%nact)])
     allocate (irn(m), jcn(m), val(m), gap(nr), key(2, nr), fval(m))
     m = 0; r = 0
     do k = 1, c%set%nact
@@ -200,6 +205,22 @@ contains
             if (w > 0) val(m) = -1/ks
           end if
         end do
+        ! a rim fibre's curvature: Newton's stiffness -lambda wgg along n on the node's fibre,
+        ! the row's compliance (eliminated, as across a slip; multiplier 0 at each iterate).
+        ! Without it a tube crushed onto a plane, whose edge fibres came to rest where their
+        ! offset fades in, converged by fixed point and stopped (contraction 0.47 an iteration)
+        if (a%bend) then
+          r = r + 1; gap(r) = 0
+          key(:, r) = [-(4*a%node + 2), a%elem]
+          kb = -a%lambda*a%wgg
+          w = merge(1._dp, 0._dp, kb /= 0)
+          do j = 1, 3
+            if (eq(dof(a%node, 3 + j)) == 0) cycle
+            m = m + 1; irn(m) = neq + r; jcn(m) = eq(dof(a%node, 3 + j)); val(m) = w*a%n(j); fval(m) = val(m)
+          end do
+          m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = -1; fval(m) = 0
+          if (kb /= 0) val(m) = -1/kb
+        end if
       end associate
     end do
     irn = irn(1:m); jcn = jcn(1:m); val = val(1:m); fval = fval(1:m)

@@ -1,6 +1,7 @@
 !> The commands that work on a deck: `check` (read, sanity, build) and `run` (the time loop:
 !> step, account, write). Exit codes: 0 done, 2 bad input, 3 the solver could not go on.
 module casca_run
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use casca_kinds, only: dp
   use casca_error, only: error_t
   use casca_deck, only: deck_t, read_deck, unset, add_problem, default_newton_tol
@@ -118,6 +119,7 @@ contains
     call read_deck(path, deck)
     if (deck%nproblems == deck%readable_problems) call check_deck(deck)   ! (the others' values too)
     if (deck%nproblems == 0) call build_model(deck, model)
+    if (deck%nproblems == 0) call check_thickness()
     if (deck%nproblems == 0) call check_overlap()
     if (present(gaps)) then
       if (gaps .and. deck%nproblems == 0) call gap_report()
@@ -133,6 +135,22 @@ contains
       code = exit_input
     end if
   contains
+    !> a thickness above half its body's size is no shell: a length in another unit (2 for
+    !> 0.002 on a ball of 0.05 m weighed 66 t and ran)
+    subroutine check_thickness()
+      real(dp) :: size
+      integer :: b
+      do b = 1, model%nbody
+        associate (bd => model%body(b))
+          size = maxval(maxval(model%x0(:, bd%node_first:bd%node_last), dim=2) - &
+                        minval(model%x0(:, bd%node_first:bd%node_last), dim=2))
+          if (bd%thickness > 0.5_dp*size) call add_problem(deck, deck%bodies(b)%line, '&body '//bd%name// &
+            ': thickness '//rtoa(bd%thickness)//' m is more than half the body''s size, '//rtoa(size)// &
+            ' m: no shell is that thick (a length in another unit?)')
+        end associate
+      end do
+    end subroutine check_thickness
+
     !> bodies of a contact pair that overlap at the start are refused, never ignored
     subroutine check_overlap()
       type(contact_t) :: probe
@@ -893,6 +911,7 @@ contains
       print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
         '  dt', r%nm%dt, '  newton/step', real(r%total_newton - last%newton)/max(st%step - last%step, 1), &
         '  contacts', nc, '  elapsed', now - r%t0, ' s  left', rate*max(r%deck%run%t_end - st%t, 0._dp), ' s'
+      flush (output_unit)   ! (read as it goes from a file or a batch system's log, and kept if the run is killed)
       last = progress_t(now, st%t, st%step, r%total_newton)
     end associate
   end subroutine progress
