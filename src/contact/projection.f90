@@ -296,7 +296,9 @@ contains
   !> towards u. Where the shell may touch with its edge (rim: a node on its shell's free
   !> edge; rim absent: the target's side) the offset fades to 0 as the fibre turns across u:
   !> f = (h/2) s k phi(|k|), k = G.u, phi a smoothstep from 0 at |k| = 0.25 (75 degrees, G
-  !> being of about unit length) to 1 at 0.5 (60 degrees), so that a strip meeting a wall
+  !> being of about unit length) to 1 at 0.5 (60 degrees), of second order (10 t^3 - 15 t^4 +
+  !> 6 t^5: f's curvature, in Newton's tangent, has no jump at either end; with 3 t^2 - 2 t^3
+  !> a crushed tube's edge fibres, at rest near 0.25, cycled across it), so that a strip meeting a wall
   !> edge-on has no offset and no moment on its fibre (the pressure spreads over the edge's
   !> thickness), and the offset has no jump anywhere. f depends on G through k alone, so w
   !> is its whole derivative (phi of |k|/|G| left G's stretch out of the row: a thick blade
@@ -331,10 +333,11 @@ contains
       ! (no offset here, whichever face: a fibre turning through edge-on takes the face
       ! towards u, held, it measured from the far face past it and let the near one in)
       if (t == 0) s = merge(1, -1, k >= 0)
-      phi = t*t*(3 - 2*t)
-      dphi = r*6*t*(1 - t)/(r2 - r1)   ! r phi'(r): d(k phi(|k|))/dk = phi + r phi'
+      phi = t**3*(10 - 15*t + 6*t*t)
+      dphi = r*30*t*t*(1 - t)**2/(r2 - r1)   ! r phi'(r): d(k phi(|k|))/dk = phi + r phi'
       ! d2(k phi(|k|))/dk2 = sign(k) (2 phi' + r phi''), inside the band only
-      if (t > 0 .and. t < 1) ddphi = sign(1._dp, k)*(12*t*(1 - t)/(r2 - r1) + r*6*(1 - 2*t)/(r2 - r1)**2)
+      if (t > 0 .and. t < 1) ddphi = sign(1._dp, k)*(60*t*t*(1 - t)**2/(r2 - r1) &
+                                                      + r*60*t*(1 - t)*(1 - 2*t)/(r2 - r1)**2)
     end if
     f = 0.5_dp*h*s*k*phi
     w = 0.5_dp*h*s*(phi + dphi)
@@ -364,8 +367,8 @@ contains
   !> direction: C_row = sum_j w(j) e(node(j), par(j)) (x) dir, par 0 the mid-surface point Y,
   !> 1 the fibre G (the Y entries first). kind 0: the normal row along n; kind 1, 2: the stick
   !> rows along t1, t2; kind 3: along the slip direction s (the sliding force's, mu_d |lambda|
-  !> on it); kind 4 (across): across s in the tangent plane, n x s. Each acts on the mid-surface points and, between faces, on the fibres that carry
-  !> the offset: the faces touch, and stick or slide, where they are. force: the row as the
+  !> on it); kind 4 (across): across s in the tangent plane, n x s. Each acts on the
+  !> mid-surface points and, between faces, on the fibres that carry the offset: the faces touch, and stick or slide, where they are. force: the row as the
   !> force acts, at shpf, friction included (at the gap's point, half a step's slide away,
   !> the friction pair had a moment: a spinning ball rattling in a shell lost 2.9e-4 of L
   !> in one impact, 3.5e-6 at shpf, test_friction 'rattle'). (The correction's mass solves
