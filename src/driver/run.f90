@@ -138,14 +138,14 @@ contains
     !> a thickness above half its body's size is no shell: a length in another unit (2 for
     !> 0.002 on a ball of 0.05 m weighed 66 t and ran)
     subroutine check_thickness()
-      real(dp) :: size
+      real(dp) :: extent
       integer :: b
       do b = 1, model%nbody
         associate (bd => model%body(b))
-          size = maxval(maxval(model%x0(:, bd%node_first:bd%node_last), dim=2) - &
+          extent = maxval(maxval(model%x0(:, bd%node_first:bd%node_last), dim=2) - &
                         minval(model%x0(:, bd%node_first:bd%node_last), dim=2))
-          if (bd%thickness > 0.5_dp*size) call add_problem(deck, deck%bodies(b)%line, '&body '//bd%name// &
-            ': thickness '//rtoa(bd%thickness)//' m is more than half the body''s size, '//rtoa(size)// &
+          if (bd%thickness > 0.5_dp*extent) call add_problem(deck, deck%bodies(b)%line, '&body '//bd%name// &
+            ': thickness '//rtoa(bd%thickness)//' m is more than half the body''s size, '//rtoa(extent)// &
             ' m: no shell is that thick (a length in another unit?)')
         end associate
       end do
