@@ -368,7 +368,8 @@ contains
   !> 1 the fibre G (the Y entries first). kind 0: the normal row along n; kind 1, 2: the stick
   !> rows along t1, t2; kind 3: along the slip direction s (the sliding force's, mu_d |lambda|
   !> on it); kind 4 (across): across s in the tangent plane, n x s. Each acts on the
-  !> mid-surface points and, between faces, on the fibres that carry the offset: the faces touch, and stick or slide, where they are. force: the row as the
+  !> mid-surface points and, between faces, on the fibres that carry the offset: the faces
+  !> touch, and stick or slide, where they are. force: the row as the
   !> force acts, at shpf, friction included (at the gap's point, half a step's slide away,
   !> the friction pair had a moment: a spinning ball rattling in a shell lost 2.9e-4 of L
   !> in one impact, 3.5e-6 at shpf, test_friction 'rattle'). (The correction's mass solves

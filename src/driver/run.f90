@@ -143,7 +143,7 @@ contains
       do b = 1, model%nbody
         associate (bd => model%body(b))
           extent = maxval(maxval(model%x0(:, bd%node_first:bd%node_last), dim=2) - &
-                        minval(model%x0(:, bd%node_first:bd%node_last), dim=2))
+                          minval(model%x0(:, bd%node_first:bd%node_last), dim=2))
           if (bd%thickness > 0.5_dp*extent) call add_problem(deck, deck%bodies(b)%line, '&body '//bd%name// &
             ': thickness '//rtoa(bd%thickness)//' m is more than half the body''s size, '//rtoa(extent)// &
             ' m: no shell is that thick (a length in another unit?)')
