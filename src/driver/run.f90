@@ -77,6 +77,9 @@ module casca_run
     !> checkpoint, with cap_since)
     real(dp) :: dt_cap = huge(1._dp)
     real(dp) :: cap_since = 0                   !< when dt_cap was set or last doubled
+    !> the energy the last free step made (energy_accepted): a step may make back what the
+    !> one before removed
+    real(dp) :: made_last = 0
     logical :: floor_told = .false.             !< with sc: a step kept above the tolerance was told
     type(balance_t) :: bal, bal0                !< now, and at the start of the run
     !> the energy a step made (the remainder of the balance fell): the largest, when, and the
@@ -244,7 +247,7 @@ contains
     type(run_t), intent(inout) :: r
     character(len=*), intent(in) :: path, out_dir
     integer :: k
-    real(dp) :: cap(2)   !< the energy's cap on the steps, from a checkpoint
+    real(dp) :: cap(3)   !< the energy's cap on the steps, from a checkpoint
     character(len=300), allocatable :: far(:)
     call load_scene(path, r%deck, r%model, r%code)
     if (r%code /= exit_ok) return
@@ -285,7 +288,7 @@ contains
                              r%dt_try, cap, r%bal%pressure_path)
         if (failed(r, 'restart')) return
         r%bal%q_path = r%st%q   ! (the pressures' work on open surfaces goes on from here)
-        r%dt_cap = cap(1); r%cap_since = cap(2)
+        r%dt_cap = cap(1); r%cap_since = cap(2); r%made_last = cap(3)
         r%restart_step = r%st%step
       end if
     end associate
@@ -357,7 +360,7 @@ contains
         made = r%rest_last - rest
         if (r%sc%tol > 0 .and. guarded) then
           if (in_contact()) then
-            r%dt_cap = huge(1._dp)
+            r%dt_cap = huge(1._dp); r%made_last = 0
           else if (step_judged(r)) then
             if (.not. energy_accepted(r, made, energy_scale())) then
               call undo_step()
@@ -671,15 +674,21 @@ contains
 
   !> Whether the step's energy is within the tolerance while no contact is active
   !> (casca_step_control's energy_error): if not, it is taken again shorter, and later steps
-  !> are shorter too (dt_cap); if so, the next step is no longer than the energy allows
+  !> are shorter too (dt_cap); if so, the next step is no longer than the energy allows.
+  !> What the step before removed is credited: a body vibrating after its release makes and
+  !> removes energy in turn under generalized-alpha, whose K + S is not its conserved energy,
+  !> and judged alone its steps fell to 0.78 us where 50 us kept the error (a ring thrown
+  !> onto a compliant floor at tolerance 1e-5: 210 steps, 150 of them after the bounce; 89
+  !> with the credit, its velocity's error the same)
   logical function energy_accepted(r, made, scale) result(ok)
     type(run_t), intent(inout) :: r
     real(dp), intent(in) :: made, scale
     real(dp) :: err, ratio, h
     h = r%nm%dt
-    err = energy_error(r%sc, made, scale)
+    err = energy_error(r%sc, made + min(0._dp, r%made_last), scale)
     ratio = next_step_ratio(r%sc, err)
     ok = err <= 1 .or. h <= r%sc%dt_min
+    if (ok) r%made_last = made
     if (.not. ok) then
       r%dt_try = max(h*ratio, r%sc%dt_min)
       r%dt_cap = h   ! (it would be tried again as soon as a shorter one makes little)
@@ -924,7 +933,7 @@ contains
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
     if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, &
                                                   r%bal%pressure_path, r%contact, e, r%dt_try, &
-                                                  [r%dt_cap, r%cap_since])
+                                                  [r%dt_cap, r%cap_since, r%made_last])
     call share_error(e)
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message

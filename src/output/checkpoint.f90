@@ -80,8 +80,9 @@ contains
     type(contact_t), intent(in), optional :: contact
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)
-    !> and the energy's cap on it (huge: none) and when it was set or last doubled
-    real(dp), intent(in), optional :: cap(2)
+    !> and the energy's cap on it (huge: none), when it was set or last doubled, and the
+    !> energy the last step made (casca_run's energy_accepted)
+    real(dp), intent(in), optional :: cap(3)
     integer, allocatable :: ints(:)
     real(dp), allocatable :: reals(:)
     integer :: k, nact
@@ -137,13 +138,13 @@ contains
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
     real(dp), intent(out), optional :: dt_next   !< 0: not in the checkpoint
-    real(dp), intent(out), optional :: cap(2)    !< [huge, 0]: not in the checkpoint
+    real(dp), intent(out), optional :: cap(3)    !< [huge, 0, 0]: not in the checkpoint
     !> the pressures' work on open surfaces so far (0: not in the checkpoint, which one
     !> written before it was kept or of a scene without such pressures is)
     real(dp), intent(out), optional :: pressure_work
     real(dp), allocatable :: pw
     integer, allocatable :: ints(:), fp(:), cs(:)
-    real(dp), allocatable :: cp(:)   ! (the energy's cap and when it was set)
+    real(dp), allocatable :: cp(:)   ! (the energy's cap, when it was set, the last step's energy)
     real(dp), allocatable :: reals(:)
     integer :: k, nact, node, pair, per
     character(len=:), allocatable :: bad
@@ -177,14 +178,15 @@ contains
     if (bad == '' .and. present(dt_next)) then
       if (.not. (dt_next >= 0 .and. dt_next <= t_max)) bad = 'its next step is outside [0, t_end]'
     end if
-    if (present(cap)) cap = [huge(1._dp), 0._dp]
+    ! (a checkpoint written before the last step's energy was kept has 2 numbers: it is 0)
+    if (present(cap)) cap = [huge(1._dp), 0._dp, 0._dp]
     if (bad == '' .and. allocated(cp)) then
-      if (size(cp) /= 2) then
-        bad = 'its cap on the steps has '//itoa(size(cp))//' numbers, not 2'
-      else if (.not. (cp(1) > 0 .and. cp(2) >= 0 .and. cp(2) <= t_max)) then
-        bad = 'its cap on the steps is not positive or was set outside [0, t_end]'
+      if (size(cp) /= 2 .and. size(cp) /= 3) then
+        bad = 'its cap on the steps has '//itoa(size(cp))//' numbers, not 3'
+      else if (.not. (cp(1) > 0 .and. cp(2) >= 0 .and. cp(2) <= t_max .and. ieee_is_finite(cp(size(cp))))) then
+        bad = 'its cap on the steps is not positive, was set outside [0, t_end] or has an energy not finite'
       else if (present(cap)) then
-        cap = cp
+        cap(1:size(cp)) = cp
       end if
     end if
     if (bad == '') then
