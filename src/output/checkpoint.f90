@@ -84,7 +84,7 @@ contains
     !> energy the last step made (casca_run's energy_accepted)
     real(dp), intent(in), optional :: cap(3)
     integer, allocatable :: ints(:)
-    real(dp), allocatable :: reals(:)
+    real(dp), allocatable :: reals(:), last(:)
     integer :: k, nact
     if (.not. is_root()) return
     nact = 0
@@ -119,9 +119,13 @@ contains
       ints = [level, 0]
       allocate (reals(0))
     end if
+    ! (the last step's length and start acceleration, which the next step's start follows
+    ! if its length differs: casca_time_scheme's moved_start; none: not written)
+    last = [real(dp) ::]
+    if (st%h_last > 0) last = [st%h_last, st%qdd_last]
     call write_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, &
                           model_fingerprint(model), dt_next, &
-                          state_checksum(st, ints, [reals, pressure_work]), cap, pressure_work)
+                          state_checksum(st, ints, [reals, pressure_work]), cap, pressure_work, last)
   end subroutine save_checkpoint
 
   !> Read the checkpoint path into st, level and the contact active set, after checking that
@@ -145,14 +149,14 @@ contains
     real(dp), allocatable :: pw
     integer, allocatable :: ints(:), fp(:), cs(:)
     real(dp), allocatable :: cp(:)   ! (the energy's cap, when it was set, the last step's energy)
-    real(dp), allocatable :: reals(:)
+    real(dp), allocatable :: reals(:), last(:)
     integer :: k, nact, node, pair, per
     character(len=:), allocatable :: bad
     logical :: with_fa, with_hold
 
     level = 0
     call read_checkpoint(path, st%t, st%step, st%q, st%qd, st%qdd, ints, reals, err, fp, dt_next, cs, &
-                         cp, pw)
+                         cp, pw, last)
     if (allocated(err)) return
     if (present(pressure_work)) pressure_work = 0
     bad = ''
@@ -187,6 +191,15 @@ contains
         bad = 'its cap on the steps is not positive, was set outside [0, t_end] or has an energy not finite'
       else if (present(cap)) then
         cap(1:size(cp)) = cp
+      end if
+    end if
+    st%h_last = 0
+    if (bad == '' .and. allocated(last)) then
+      if (size(last) /= model%ndof + 1 .or. .not. all(ieee_is_finite(last)) .or. .not. last(1) > 0) then
+        bad = 'its last step (length and start acceleration) has '//itoa(size(last))// &
+              ' numbers, not '//itoa(model%ndof + 1)//', or is not finite or not positive'
+      else
+        st%h_last = last(1); st%qdd_last = last(2:)
       end if
     end if
     if (bad == '') then

@@ -333,7 +333,7 @@ contains
   !> q, qd, qdd must have the same size ndof; ints and reals (the caller's extra state) may
   !> have any size, including 0.
   subroutine write_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
-                              checksum, dt_cap, pressure_work)
+                              checksum, dt_cap, pressure_work, last)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: t
     integer, intent(in) :: step
@@ -346,6 +346,7 @@ contains
     integer, intent(in), optional :: checksum(:)
     real(dp), intent(in), optional :: dt_cap(:) !< the energy's cap on the steps, when set, the last step's energy (idem)
     real(dp), intent(in), optional :: pressure_work   !< the pressures' on open surfaces so far
+    real(dp), intent(in), optional :: last(:)   !< the last step's length and start acceleration (empty: none)
 
     character(len=*), parameter :: who = 'write_checkpoint'
     integer(hid_t) :: fid
@@ -380,14 +381,17 @@ contains
       call put_real_1d(who, path, fid, 'dt_cap', dt_cap, err)
     if (present(pressure_work) .and. .not. allocated(err)) &
       call put_real_scalar(who, path, fid, 'pressure_work', pressure_work, err)
+    if (present(last) .and. .not. allocated(err)) then
+      if (size(last) > 0) call put_real_1d(who, path, fid, 'last', last, err)
+    end if
     if (.not. allocated(err)) call save_image(who, path, fid, err)
     call h5fclose_f(fid, h)   ! (in memory: nothing to fail on)
   end subroutine write_checkpoint
 
   !> Read a checkpoint written by write_checkpoint (fingerprint, checksum: not allocated if it
-  !> has none; dt_next: 0 if it has none; dt_cap, pressure_work: not allocated if it has none).
+  !> has none; dt_next: 0 if it has none; dt_cap, pressure_work, last: not allocated if it has none).
   subroutine read_checkpoint(path, t, step, q, qd, qdd, ints, reals, err, fingerprint, dt_next, &
-                             checksum, dt_cap, pressure_work)
+                             checksum, dt_cap, pressure_work, last)
     character(len=*), intent(in) :: path
     real(dp), intent(out) :: t
     integer, intent(out) :: step
@@ -400,6 +404,7 @@ contains
     integer, allocatable, intent(out), optional :: checksum(:)
     real(dp), allocatable, intent(out), optional :: dt_cap(:)
     real(dp), allocatable, intent(out), optional :: pressure_work
+    real(dp), allocatable, intent(out), optional :: last(:)
 
     character(len=*), parameter :: who = 'read_checkpoint'
     integer(hid_t) :: fid
@@ -443,6 +448,10 @@ contains
         allocate (pressure_work)
         call get_real_scalar(who, path, fid, 'pressure_work', pressure_work, err)
       end if
+    end if
+    if (present(last) .and. .not. allocated(err)) then
+      call h5lexists_f(fid, 'last', has_dt, h)
+      if (h == 0 .and. has_dt) call get_real_1d(who, path, fid, 'last', last, err)
     end if
     call h5fclose_f(fid, h)
     if (allocated(err)) return

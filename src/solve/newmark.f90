@@ -24,6 +24,11 @@ module casca_newmark
     real(dp) :: t = 0
     integer :: step = 0
     real(dp), allocatable :: q(:), qd(:), qdd(:)
+    !> the last step's length and start acceleration (scheme_t's moved_start) where no
+    !> contact was active at its start or end; 0: none (a contact's force jumps, and its
+    !> acceleration's change is no rate)
+    real(dp) :: h_last = 0
+    real(dp), allocatable :: qdd_last(:)
   end type state_t
 
 contains
@@ -56,12 +61,15 @@ contains
     type(constraint_t), allocatable :: before(:), released(:)
     real(dp) :: dt, g
     integer :: k, iters
-    logical :: compliant
+    logical :: compliant, free
 
     g = nm%gamma; dt = nm%dt
     compliant = .false.
     if (present(contact)) compliant = contact%opt%compliant
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
+    free = .true.
+    if (present(contact)) free = contact%set%nact == 0
+    if (free .and. st%h_last > 0) call nm%moved_start(st%h_last, st%qdd_last, a0)
     allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
       call contact_force_points(contact, model, nm%alpha_f, st%q)   ! (as the last step left them: restarts too)
@@ -104,6 +112,11 @@ contains
     if (present(contact)) then   ! (before friction turns its slip directions)
       call add_step_impulse(contact, nm, released, nu, f_end)
       call friction_step_done(contact, nm, before)
+    end if
+    st%h_last = 0
+    if (present(contact)) free = free .and. contact%set%nact == 0
+    if (free) then
+      st%h_last = dt; st%qdd_last = a0
     end if
     st%q = q; st%qd = qd; st%qdd = qdd
     st%t = st%t + dt
