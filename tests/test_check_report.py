@@ -41,6 +41,10 @@ ring in ring   a small ring (R 0.08, 16 cells) at the centre of a big one (R 0.2
                one's over the closing speed along the wall's normal. (Before 2026-11-28 the time
                was the closest node's gap over its speed: the centred ring's nearest nodes moved
                sideways, and off the axis it came 19% late.)
+spheres        two spheres head-on (R 0.1 and 0.15, h 2 and 3 mm, closing at 7 m/s, faces 2 mm
+               apart): the time lies between 2 mm / 7 m/s and that plus what the meshes' faceting
+               can add (the nearest node off the axis by a sub-triangle's circumradius, and the
+               target's chord sagitta) over 7 m/s.
 denser target  a thin tube (R 40 mm, width 120 mm, 16 x 3 cells) listed as the target of a plate
                (0.3 m, 8 x 8 cells): the warning gives the plate's area per node over the tube's,
                (0.3^2 / 25^2) / (2 pi R w / (48 x 10)) = 2.29, within 1%; listed the other way
@@ -190,6 +194,31 @@ ck.record("ring in ring off the axis: time to contact within the circles' rigid 
           "ring's sagitta, plus the small one's, over the normal closing speed",
           sb[2] is not None and lo_t * (1 - 1e-6) <= sb[2] <= hi_t * (1 + 1e-6),
           "%s in [%.8g, %.8g]" % (sb[2], lo_t, hi_t))
+# two spheres head-on (a: R 0.1, h 2 mm at 5 m/s; b: R 0.15, h 3 mm at -2 m/s; centres 0.2545
+# apart): the smooth spheres' faces are 2 mm apart, so the time is at least 2 mm / 7 m/s. The
+# meshes put no node on the axis: a's nearest node is off it by at most its sub-triangle's
+# circumradius rho = e_a / sqrt 3, and along x its path meets b's sphere later by
+# rho^2 / 2 (1 / R_a + 1 / R_b), and b's chords (sagitta e_b^2 / (8 R_b)) later still; e is
+# the icosahedron's edge R / sin 72 deg over 3 n_div, stretched by up to 1 / 0.7947 (its
+# inradius over its circumradius) where projected onto the sphere. (Before 2026-11-28 the
+# path, aimed at the chord between two of b's nodes, missed both triangles' offset planes: 4.9e-4 s.)
+def sphere_edge(rs):
+    return rs / math.sin(math.radians(72)) / 9 / 0.7947
+
+
+ra, rb = 0.1, 0.15
+rho = sphere_edge(ra) / math.sqrt(3)
+lo_t = (0.2545 - ra - rb - 0.0025) / 7
+hi_t = lo_t + (rho**2 / 2 * (1 / ra + 1 / rb) + sphere_edge(rb) ** 2 / (8 * rb)) / 7
+sp = check("spheres_head_on", f"""&run dt = 1e-5, t_end = 2e-3 /
+&body name = 'a', mesh = 'sphere', radius = {ra}, n_div = 3, velocity = 5, 0, 0, {STEEL}, thickness = 0.002 /
+&body name = 'b', mesh = 'sphere', radius = {rb}, n_div = 3, center = 0.2545, 0, 0, velocity = -2, 0, 0,
+  {STEEL}, thickness = 0.003 /
+""").get(("a", "b"), (None,) * 3)
+ck.record("spheres head-on: time to contact within [the smooth faces' 2 mm / 7 m/s, plus the meshes' "
+          "offsets from the axis and b's sagitta over 7 m/s]",
+          sp[2] is not None and lo_t <= sp[2] <= hi_t, "%s in [%.6g, %.6g]" % (sp[2], lo_t, hi_t))
+
 # a thin tube (R 40 mm, 120 mm, 16 x 3 cells) listed as the target of a coarse plate (0.3 m,
 # 8 x 8 cells): the tube's area per node, 2 pi R w / (3*16 (3*3 + 1)), is the plate's
 # 0.3^2 / 25^2 over 2.29; with one pass the warning names that ratio, listed the other way
