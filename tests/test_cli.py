@@ -231,6 +231,11 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("misspelt body in the pairs", lambda s: s + "&contact\n pairs = 'ring1', 'rings2'\n/\n",
      ["pairs(:, 1)", "rings2", "did you mean 'ring2'?"]),
     ("misspelt key in &contact", lambda s: s + "&contact\n tolerence = 1e-6\n/\n", ["&contact", "tolerence", "did you mean 'tolerance'?"]),
+    # (a misspelt key is left out of the read, so the other values are still checked)
+    ("a misspelt key beside bad values", lambda s: s.replace("dt = 5.0e-5", "dt = -1.0e-5")
+     .replace("poisson = 0.3, density", "poisson = 0.5, densty", 1),
+     ["unknown key 'densty' (did you mean 'density'?)", "dt must be > 0", "poisson must be in (-1, 0.5)",
+      "density is missing", "4 problems in the deck"]),
     ("a key of another group", lambda s: s.replace("young = 210e9, ", "young = 210e9, pressure = 1e3, ", 1),
      ["&body", "unknown key 'pressure'", "(a key of &load)"]),
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),

@@ -440,14 +440,14 @@ contains
   !> Names and lines of every '&group' in the file; unknown names are problems (a misspelt
   !> group would otherwise be skipped silently by the namelist reader).
   subroutine scan_groups(u, deck, gname, gline)
-    integer, intent(in) :: u
+    integer, intent(inout) :: u   !< the deck; a scratch copy without its unknown keys if any
     type(deck_t), intent(inout) :: deck
     character(len=16), allocatable, intent(out) :: gname(:)
     integer, allocatable, intent(out) :: gline(:)
     character(len=max_line_len) :: line
     character(len=max_line_len), allocatable :: text(:)
     character(len=16) :: name
-    integer :: ios, n, j, k, nread
+    integer :: ios, n, j, k, nread, unknown
     integer, allocatable :: lines(:), key_lines(:)
     character(len=512), allocatable :: msgs(:)
     character(len=20), allocatable :: keys(:)
@@ -489,14 +489,27 @@ contains
     rewind (u)
     allocate (deck%key_name(0), deck%key_group_line(0), deck%key_line(0))
     do k = 1, size(gname)
-      call lint_group(text, gline(k), trim(gname(k)), lines, msgs, keys, key_lines)
+      call lint_group(text, gline(k), trim(gname(k)), lines, msgs, keys, key_lines, unknown)
       do j = 1, size(lines)
         call add_problem(deck, lines(j), trim(msgs(j)))
       end do
+      deck%readable_problems = deck%readable_problems + unknown   ! (blanked out of text)
       deck%key_name = [deck%key_name, keys]
       deck%key_group_line = [deck%key_group_line, spread(gline(k), 1, size(keys))]
       deck%key_line = [deck%key_line, key_lines]
     end do
+    if (deck%readable_problems == 0 .or. deck%nproblems > deck%readable_problems) return
+    ! (the groups are read from the text without its unknown keys, line for line)
+    close (u)
+    open (newunit=u, status='scratch', action='readwrite', iostat=ios)
+    if (ios /= 0) then
+      call add_problem(deck, 0, 'cannot open a scratch file to read the deck without its unknown keys')
+      return
+    end if
+    do k = 1, size(text)
+      write (u, '(a)') trim(text(k))
+    end do
+    rewind (u)
   end subroutine scan_groups
 
   subroutine read_run(u, deck, line)
@@ -535,7 +548,7 @@ contains
       c%tolerance = tolerance; c%tolerance_length = tolerance_length
       if (rho_inf /= unset .and. (beta /= unset .or. gamma /= unset)) then
         call add_problem(deck, line, &
-          '&run: give either rho_inf (generalized-alpha) or beta and gamma (Newmark), not both')
+          '&run: rho_inf (generalized-alpha) is given with beta or gamma (Newmark): give one or the other')
         deck%readable_problems = deck%readable_problems + 1
       end if
       if (beta /= unset) c%beta = beta

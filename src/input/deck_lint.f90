@@ -82,17 +82,21 @@ contains
   !> Check the group whose '&name' is on line first of text(:). Each problem is returned as
   !> a line number and a message (returned, not reported through a callback: an internal
   !> procedure passed as an argument would need a trampoline on an executable stack); and
-  !> each key given (not indexed), with its line.
-  subroutine lint_group(text, first, group, lines, msgs, keys, key_lines)
-    character(len=*), intent(in) :: text(:), group
+  !> each key given (not indexed), with its line. An unknown key is blanked out of text with
+  !> its values (unknown: how many), so that the namelist read of the rest still checks the
+  !> other keys' values: one slip does not hide the deck's other problems.
+  subroutine lint_group(text, first, group, lines, msgs, keys, key_lines, unknown)
+    character(len=*), intent(inout) :: text(:)
+    character(len=*), intent(in) :: group
     integer, intent(in) :: first
     integer, allocatable, intent(out) :: lines(:)
     character(len=512), allocatable, intent(out) :: msgs(:)
     character(len=20), allocatable, intent(out) :: keys(:)
     integer, allocatable, intent(out) :: key_lines(:)
+    integer, intent(out) :: unknown
     character(len=:), allocatable :: s, key, item
-    integer, allocatable :: lineof(:)
-    integer :: i, j, k, n, p
+    integer, allocatable :: lineof(:), colof(:)
+    integer :: i, j, k, n, p, bad
     character(len=1) :: t, q
     logical :: done
     integer :: nval, key_line
@@ -100,13 +104,14 @@ contains
 
     ! the group as one string (comments cut), with the line of each character
     allocate (lines(0), msgs(0), keys(0), key_lines(0))
+    unknown = 0; bad = 0   ! (bad: where the unknown key being read starts in s)
     s = ''
-    allocate (lineof(0))
+    allocate (lineof(0), colof(0))
     do i = first, size(text)
       if (i > first .and. starts_group(text(i))) exit   ! (the next group: this one is open)
       k = comment_start(text(i))
       s = s//text(i)(1:k - 1)//' '
-      lineof = [lineof, spread(i, 1, k)]
+      lineof = [lineof, spread(i, 1, k)]; colof = [colof, (j, j=1, k)]
       if (group_ends(s)) exit
     end do
     if (.not. group_ends(s)) then   ! (the read would run into the next group: keys by the dozen)
@@ -142,6 +147,7 @@ contains
         p = p + 1
       case ('/')
         call key_done()
+        call blank_bad()
         done = .true.
       case ("'", '"')
         comma = .false.
@@ -177,12 +183,15 @@ contains
         end do
         if (k <= n .and. s(k:k) == '=') then   ! a key
           call key_done()
+          call blank_bad()
           key = lower(item)
           indexed = index(key, '(') > 0
           if (indexed) key = key(1:index(key, '(') - 1)
           t = key_type(group, key)
-          if (t == ' ') call report(lineof(p), '&'//group//': unknown key '''//key//''''// &
-                                    suggestion(group, key))
+          if (t == ' ') then
+            call report(lineof(p), '&'//group//': unknown key '''//key//''''//suggestion(group, key))
+            bad = p; unknown = unknown + 1
+          end if
           key_line = lineof(p); nval = 0
           if (t /= ' ' .and. .not. indexed) call once()
           p = k + 1
@@ -276,6 +285,16 @@ contains
       if (nval /= 3) call report(key_line, '&'//group//': '//key//' takes 3 numbers (x, y, z), '// &
                                  itoa(nval)//' given')
     end subroutine key_done
+
+    !> the unknown key read last and its values, up to where the next key or the '/' is (p)
+    subroutine blank_bad()
+      integer :: m
+      if (bad == 0) return
+      do m = bad, p - 1
+        text(lineof(m))(colof(m):colof(m)) = ' '
+      end do
+      bad = 0
+    end subroutine blank_bad
 
     subroutine report(line, msg)
       integer, intent(in) :: line

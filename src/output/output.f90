@@ -131,7 +131,8 @@ contains
     allocate (out%files(0), out%times(0))
     if (.not. is_root()) return
     if (.not. make_dir(out%dir)) then
-      call fatal_error(err, 'cannot create the output folder '//out%dir); return
+      call fatal_error(err, 'cannot create the output folder '//out%dir// &
+                       ' (the deck''s &output: dir, or --out; is its parent writable?)'); return
     end if
     call lock_folder(out%dir, note, err)
     if (allocated(err)) return

@@ -180,7 +180,8 @@ contains
     type(balance_t), intent(in) :: b0, b
     type(energy_term_t), intent(in), optional :: extra(:)
     character(len=:), allocatable :: line
-    real(dp) :: rest
+    real(dp) :: rest, put
+    character(len=:), allocatable :: what
     integer :: k
     rest = balance_remainder(b0, b, extra)
     line = 'energy balance: E0 = '//rtoa(b0%total)//' J, kinetic '//rtoa(b%kinetic)//', strain '// &
@@ -191,8 +192,20 @@ contains
       end do
     end if
     line = line//', removed by the time integrator and contact '//rtoa(rest)
-    if (abs(rest) < 1e6_dp*abs(b0%total)) then   ! (not of an E0 that is zero or nearly)
-      line = line//' ('//ftoa(100*rest/abs(b0%total))//'% of E0)'
+    ! (a share of all the energy put in: of E0 alone, a plate dropped onto a floor under
+    ! gravity had 102% of it removed)
+    put = abs(b0%total) + max(b%work, 0._dp)
+    what = 'E0'
+    if (b%work > 0) what = 'E0 and the loads'' work'
+    if (present(extra)) then
+      do k = 1, size(extra)
+        if (extra(k)%source .and. extra(k)%value < 0) then   ! (a source's value is minus what it gave)
+          put = put - extra(k)%value; what = 'E0 and the work put in'
+        end if
+      end do
+    end if
+    if (abs(rest) < 1e6_dp*put) then   ! (not of an E0 that is zero or nearly)
+      line = line//' ('//ftoa(100*rest/put)//'% of '//what//')'
     end if
   end function energy_balance
 end module casca_accounting
