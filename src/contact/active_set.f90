@@ -61,7 +61,7 @@ contains
           end if   ! (else far from every sub-triangle within reach: keep the last point)
         end if
         call constraint_geometry(c, model, x, q, a, normals, lever=.true.)
-        a%bend = near_fade(a)
+        a%bend = in_rounding(a)
       end associate
     end do
     if (.not. detect) return
@@ -135,24 +135,24 @@ contains
           end if
         end if
         call constraint_geometry(c, model, x, q, cn, normals, lever=.true.)   ! (its rows' too)
-        cn%bend = near_fade(cn)
+        cn%bend = in_rounding(cn)
         call push(cn)
         added = added + 1
       end if
     end subroutine take
 
-    !> A rim node between faces whose fibre is not along n: its offset may fade (projection.f90,
-    !> face: |G.n| from 0.25 to 0.5), where its curvature is Newton's stiffness (contact_rows'
-    !> bend row). Decided where a constraint is made or projected again (a step's first
-    !> iteration), so that the rows stay the same while the set does.
-    logical function near_fade(a)
+    !> A rim node between faces whose fibre is not along n: its edge may be rounded there
+    !> (projection.f90, face: |G.n| below 0.5), where the offset's curvature is Newton's
+    !> stiffness (contact_rows' bend row). Decided where a constraint is made or projected
+    !> again (a step's first iteration), so that the rows stay the same while the set does.
+    logical function in_rounding(a)
       type(constraint_t), intent(in) :: a
       real(dp) :: k
-      near_fade = .false.
+      in_rounding = .false.
       if (.not. (c%opt%faces .and. c%rim(a%node))) return
       k = abs(dot_product(q(dof(a%node, 4):dof(a%node, 6)), a%n))
-      near_fade = k < 0.7_dp
-    end function near_fade
+      in_rounding = k < 0.7_dp
+    end function in_rounding
 
     !> cn's gap at the step's start (its point, side and faces held), huge where not known
     real(dp) function start_gap(cn)

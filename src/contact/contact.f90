@@ -54,7 +54,7 @@ module casca_contact
     !> the gap's derivative on the fibres: wg(1) n.dG at the node, wg(2) sum_j N_j n.dG_j
     real(dp) :: wg(2) = 0
     !> the gap's second derivative on the impactor node's fibre, -wgg n n^T: nonzero where a
-    !> rim node's offset fades (projection.f90, face); with -lambda it is Newton's stiffness
+    !> rim node's edge is rounded (projection.f90, face); with -lambda it is Newton's stiffness
     !> along n on that fibre (contact_rows' bend row)
     real(dp) :: wgg = 0
     logical :: bend = .false.   !< with a bend row in Newton's system (contact_update decides)

@@ -231,8 +231,8 @@ contains
       con%off = con%off + ft
       con%wg(2) = -con%wg(2)
       ! the gap's derivative through n: D . dn, D = Y - T + wg1 G + wg2 G_t, whose part across
-      ! n (the face point P off the node's projection by up to 3 (h/2) sin in the rim's fade
-      ! band) turns the gap with the target's normal
+      ! n (the face point P off the node's projection by up to (h/2) sin in the rim's
+      ! rounding) turns the gap with the target's normal
       if (present(lever)) then
         if (lever .and. rim) then
           call rim_lever(model, con, x(:, con%node) - xt, con%wg(1)*q(dof(con%node, 4):dof(con%node, 6)) &
@@ -294,54 +294,56 @@ contains
   !> reference thickness), and w = (h/2) s, its derivative along -u.dG (the sign the gap
   !> takes for the face towards u). s = 0 (a new constraint) chooses, then holds, the face
   !> towards u. Where the shell may touch with its edge (rim: a node on its shell's free
-  !> edge; rim absent: the target's side) the offset fades to 0 as the fibre turns across u:
-  !> f = (h/2) s k phi(|k|), k = G.u, phi a smoothstep from 0 at |k| = 0.25 (75 degrees, G
-  !> being of about unit length) to 1 at 0.5 (60 degrees), of second order (10 t^3 - 15 t^4 +
-  !> 6 t^5: f's curvature, in Newton's tangent, has no jump at either end; with 3 t^2 - 2 t^3
-  !> a crushed tube's edge fibres, at rest near 0.25, cycled across it), so that a strip meeting a wall
-  !> edge-on has no offset and no moment on its fibre (the pressure spreads over the edge's
-  !> thickness), and the offset has no jump anywhere. f depends on G through k alone, so w
-  !> is its whole derivative (phi of |k|/|G| left G's stretch out of the row: a thick blade
-  !> landing at 62 degrees on a rigid plane gained 2.5% of E0 through its contact, now
-  !> 1e-11; against a body the row needs n's turn as well, normal_lever: a blade 8 x 8 landing
-  !> at 60 degrees on a plate gained 9.8% of E0 without it, none with it). (Until 2026-11-27 an edge was
-  !> chosen past 60 degrees, with offset 0 against the face's h/4 there: a blade landing at
-  !> 60 degrees, its fibres shaking across that angle, had nodes found at the edge's gap and
-  !> taken again at the face's, h/4 deep, and pushed out in one step: 16 times E0. A node
-  !> inside a shell lost 19% of a rubber ball's E0 the same way, and has no edge: phi = 1.)
-  !> (The element's face, (h/2)(s + a) G, moves with the thickness parameter a too; but a
-  !> has no mass and follows the contact force within a step, and fed back through the
-  !> offset it made the trapezoidal rule unstable: a ring on a floor had a grow from 3e-4 to
-  !> 9e-2 in ten steps.)
+  !> edge; rim absent: the target's side) its edge is rounded: f = (h/2) rho(k), k = G.u,
+  !> rho = |k| from |k| = 0.5 (60 degrees, G being of about unit length) and within it the
+  !> even quartic 3 d/8 + 3 k^2 / (4 d) - k^4 / (8 d^3), d = 0.5, which meets |k| with its
+  !> slope and curvature there: convex, so a pressed edge's fibre is held by the contact, no
+  !> moment on it edge-on (a strip meeting a wall edge-on: the pressure spreads over the
+  !> edge's thickness), an offset of (h/2) 3/16 there, and the face towards u whichever side
+  !> the fibre turns to. (Until 2026-11-28 the offset faded to 0 by a smoothstep in |k| from
+  !> 0.5 to 0.25: its curvature was negative near 0.5, as stiff as the fibre under a crushed
+  !> tube's edge forces, and the tube crushed in self-contact stopped at 0.348 of 1 ms with
+  !> Newton wandering on its edge fibres; rounded, it runs to the end.) f depends on G
+  !> through k alone, so w is its whole derivative (a stretch of G left out of the row: a
+  !> thick blade landing at 62 degrees on a rigid plane gained 2.5% of E0 through its contact,
+  !> now 1e-11; against a body the row needs n's turn as well, normal_lever: a blade 8 x 8
+  !> landing at 60 degrees on a plate gained 9.8% of E0 without it, none with it). (Until
+  !> 2026-11-27 an edge was chosen past 60 degrees, with offset 0 against the face's h/4
+  !> there: a blade landing at 60 degrees, its fibres shaking across that angle, had nodes
+  !> found at the edge's gap and taken again at the face's, h/4 deep, and pushed out in one
+  !> step: 16 times E0. A node inside a shell lost 19% of a rubber ball's E0 the same way,
+  !> and has no edge.) (The element's face, (h/2)(s + a) G, moves with the thickness
+  !> parameter a too; but a has no mass and follows the contact force within a step, and fed
+  !> back through the offset it made the trapezoidal rule unstable: a ring on a floor had a
+  !> grow from 3e-4 to 9e-2 in ten steps.)
   pure subroutine face(h, g, u, s, f, w, rim, w2)
     real(dp), intent(in) :: h, g(3), u(3)
     integer, intent(inout) :: s
     real(dp), intent(out) :: f, w
     logical, intent(in), optional :: rim
     real(dp), intent(out), optional :: w2   !< f's second derivative along u.dG
-    real(dp), parameter :: r1 = 0.25_dp, r2 = 0.5_dp
-    real(dp) :: k, r, t, phi, dphi, ddphi
+    real(dp), parameter :: d = 0.5_dp
+    real(dp) :: k
     logical :: edge_ok
     edge_ok = .true.
     if (present(rim)) edge_ok = rim
     k = dot_product(g, u)
     if (s == 0 .or. s == 2) s = merge(1, -1, k >= 0)   ! (2: an edge, in older checkpoints)
-    phi = 1; dphi = 0; ddphi = 0
-    if (edge_ok) then
-      r = abs(k)
-      t = min(1._dp, max(0._dp, (r - r1)/(r2 - r1)))
-      ! (no offset here, whichever face: a fibre turning through edge-on takes the face
-      ! towards u, held, it measured from the far face past it and let the near one in)
-      if (t == 0) s = merge(1, -1, k >= 0)
-      phi = t**3*(10 - 15*t + 6*t*t)
-      dphi = r*30*t*t*(1 - t)**2/(r2 - r1)   ! r phi'(r): d(k phi(|k|))/dk = phi + r phi'
-      ! d2(k phi(|k|))/dk2 = sign(k) (2 phi' + r phi''), inside the band only
-      if (t > 0 .and. t < 1) ddphi = sign(1._dp, k)*(60*t*t*(1 - t)**2/(r2 - r1) &
-                                                      + r*60*t*(1 - t)*(1 - 2*t)/(r2 - r1)**2)
+    if (present(w2)) w2 = 0
+    if (.not. edge_ok) then
+      f = 0.5_dp*h*s*k
+      w = 0.5_dp*h*s
+      return
     end if
-    f = 0.5_dp*h*s*k*phi
-    w = 0.5_dp*h*s*(phi + dphi)
-    if (present(w2)) w2 = 0.5_dp*h*s*ddphi
+    s = merge(1, -1, k >= 0)   ! (the face towards u: rho is even)
+    if (abs(k) >= d) then
+      f = 0.5_dp*h*abs(k)
+      w = 0.5_dp*h*s
+    else
+      f = 0.5_dp*h*(3*d/8 + 3*k*k/(4*d) - k**4/(8*d**3))
+      w = 0.5_dp*h*(3*k/(2*d) - k**3/(2*d**3))
+      if (present(w2)) w2 = 0.5_dp*h*(3/(2*d) - 3*k*k/(2*d**3))
+    end if
   end subroutine face
 
   !> The nodes a constraint acts on and the weights of its row of C: n on the impactor node,
@@ -692,7 +694,7 @@ contains
   !> point at the foot of the node's line along n, xi moved along the edge until
   !> r = Y - T(xi) lies across its tangent (at a corner, the held point). The pair then lies
   !> on one line but for the node's face offset across n (none where its fibre is along n
-  !> or, at its own rim, faded out), as the velocity correction's rows need: held at the
+  !> or, at its own rim, edge-on), as the velocity correction's rows need: held at the
   !> gap's point, two rings meeting rim on rim lost 4e-7 of their angular momentum.
   pure subroutine rim_force_point(xe, y, con)
     real(dp), intent(in) :: xe(3, 10)   !< the target element's mid-surface points

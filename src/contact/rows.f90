@@ -208,7 +208,8 @@ contains
         ! a rim fibre's curvature: Newton's stiffness -lambda wgg along n on the node's fibre,
         ! the row's compliance (eliminated, as across a slip; multiplier 0 at each iterate).
         ! Without it a tube crushed onto a plane, whose edge fibres came to rest where their
-        ! offset fades in, converged by fixed point and stopped (contraction 0.47 an iteration)
+        ! offset's rounding begins, converged by fixed point and stopped (contraction 0.47 an
+        ! iteration)
         if (a%bend) then
           r = r + 1; gap(r) = 0
           key(:, r) = [-(4*a%node + 2), a%elem]

@@ -1,8 +1,8 @@
 !> What `casca check` says about each contact pair at t = 0: the smallest gap between the
 !> surfaces in contact (faces: mid-surfaces less half of each reference thickness along the
-!> fibre, as a constraint measures it: (h/2)|G.u|, none for a shell met edge-on, its fibre
-!> more than 60 degrees from the line u, but h/2 all round for a target's rim met by a
-!> one-pass pair's node, rounded as projection.f90 rounds it; 'mid': the mid-surfaces) and
+!> fibre, as a constraint measures it: (h/2)|G.u|, rounded at a shell's free edge within 60
+!> degrees of edge-on to (h/2) 3/16 edge-on (projection.f90's face), but h/2 all round for a
+!> target's rim met by a one-pass pair's node; 'mid': the mid-surfaces) and
 !> the time to contact at the bodies' initial velocities.
 !>
 !> The contact's own probe only sees nodes within the search radius, so the distance here is
