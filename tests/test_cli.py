@@ -195,8 +195,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("an unknown group and a bad value", lambda s: s.replace("&output", "&outptu").replace("young = 210e9", "young = -1.0", 1),
      ["&outptu", ":4:", "young must be > 0", "2 problems in the deck"]),
     ("a scheme given twice and an unknown body", lambda s: s.replace("dt = 5.0e-5", "dt = 5.0e-5, rho_inf = 0.8, beta = 0.3")
-     + "&restraint\n body = 'ring9', fix = 'y'\n/\n", [":2:", "rho_inf (generalized-alpha) is given with beta or gamma", ":19:", "'ring9' is not a body",
-      "2 problems"]),
+     + "&restraint\n body = 'ring9', fix = 'y'\n/\n",
+     [":2:", "rho_inf (generalized-alpha) is given with beta or gamma", ":19:", "'ring9' is not a body", "2 problems"]),
     ("misspelt key", lambda s: s.replace("velocity", "velocty"), ["velocty", "velocity", ":11:"]),
     ("wrong type", lambda s: s.replace("dt = 5.0e-5", "dt = 'fast'"), ["dt", "not a number", ":2:"]),
     ("a key given twice", lambda s: s.replace("  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n",

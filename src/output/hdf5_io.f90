@@ -344,7 +344,7 @@ contains
     integer, intent(in), optional :: fingerprint(:)
     real(dp), intent(in), optional :: dt_next   !< the next step's length (error-controlled runs)
     integer, intent(in), optional :: checksum(:)
-    real(dp), intent(in), optional :: dt_cap(:) !< the energy's cap on the steps, when set, the last step's energy (idem)
+    real(dp), intent(in), optional :: dt_cap(:) !< the energy's cap on the steps, when set, last step's energy
     real(dp), intent(in), optional :: pressure_work   !< the pressures' on open surfaces so far
     real(dp), intent(in), optional :: last(:)   !< the last step's length and start acceleration (empty: none)
 
