@@ -119,8 +119,11 @@ thrown     a validator's steel hoop (R 0.1 m, width 20 mm, h 2 mm, 48 elements a
 incline_hold   a steel plate (0.1 m, h 2 mm, 4 x 4 cells) set at rest on a 20-degree incline
            (gravity tilted, a flat rigid plane), friction 0.2, static_friction 0.4 > tan 20 =
            0.364, friction_decay 100 s/m (the sliding coefficient mu_d + (mu_s - mu_d) exp(-DC
-           |v|)), thesis Newmark, dt 1 ms, 0.1 s: it stays, its centre moving less than 1e-5 m
-           along the slope (measured 2.8e-6 m, in two settling slips of its edge nodes). Without
+           |v|)), thesis Newmark, dt 1 ms, 0.1 s: it stays, its centre moving less than 1e-4 m
+           along the slope in all and less than 1e-8 m in the last 0.03 s (it has stopped).
+           The settling slips of its edge nodes took it 2.8e-6 m on one machine and 1.02e-5 m
+           on another CPU, the same code: round-off decides how many slip before it holds,
+           and 1e-4 is still 76 times short of the slide at mu_d below. Without
            friction_decay (the coefficient drops to mu_d at once) its downhill edge nodes, which
            carry its bending at 0.39 to 0.43 of their normal force, pass mu_s, shed their load at
            mu_d row after row, and it slides 7.6 mm at mu_d.
@@ -477,7 +480,10 @@ def rigid_speed(mu_s, th, t_end, n=20000):
 h = plate_incline("incline_hold", 0.4)
 if h is not None:
     ck.le("incline_hold: mu_s 0.4 > tan 20, the centre's largest displacement along the slope in 0.1 s [m] (held)",
-          np.max(np.abs(h["p1_x"] - h["p1_x"][0])), 1e-5)
+          np.max(np.abs(h["p1_x"] - h["p1_x"][0])), 1e-4)
+    half = h["t"] >= 0.07 - 1e-9
+    ck.le("incline_hold: the centre's largest displacement along the slope from 0.07 to 0.1 s [m] (stopped)",
+          np.max(np.abs(h["p1_x"][half] - h["p1_x"][half][0])), 1e-8)
 h = plate_incline("incline_hold_ga", 0.4, scheme="rho_inf = 0.8 ", t_end=0.05)
 if h is not None:
     ck.le("incline_hold_ga: the same under generalized-alpha 0.8, largest displacement along the slope in 0.05 s [m] (held)",
