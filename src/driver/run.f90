@@ -17,7 +17,7 @@ module casca_run
   use casca_newmark, only: state_t, newmark_step
   use casca_statics, only: static_solve
   use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
-  use casca_step_control, only: step_control_t, local_error, energy_error, next_step_ratio
+  use casca_step_control, only: step_control_t, local_error, depth_error, energy_error, next_step_ratio
   use casca_step_size, only: time_to_contact
   use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
                               energy_balance, balance_remainder
@@ -87,6 +87,7 @@ module casca_run
     real(dp) :: rest_last = 0, made_max = 0, t_made = 0, dt_made = 0
     real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
     integer :: made_contacts = 0
+    integer :: made_between = 0                 !< of them, between bodies (not obstacles)
     !> a body under gravity starts held by its contact (a = 0): its first step makes energy
     !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact: not watched
     logical :: held_at_start = .false.
@@ -305,7 +306,6 @@ contains
     real(dp), allocatable :: q_before(:), qd_before(:)
     type(state_t) :: st_before
     type(contact_t), allocatable :: contact_before
-    integer :: nact0   !< contacts active at the step's start
     type(balance_t) :: bal_before
     real(dp) :: rest, made
     !> a step that makes more energy than this share of what the bodies hold is taken again
@@ -384,9 +384,7 @@ contains
         else if (r%level > 0 .and. rep%iters <= 3) then
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
-        nact0 = 0
-        if (allocated(contact_before)) nact0 = contact_before%set%nact
-        call watch_energy(r, rest, nact0)
+        call watch_energy(r, rest, contact_before)
         call watch_thickness(r)
         if (.not. step_written(r, interval, next_frame, next_ckpt)) return
       end do
@@ -643,6 +641,9 @@ contains
       if (.not. r%contact%opt%compliant) call touching(r%contact)
     end if
     err = local_error(r%sc, r%nm, r%model, before%qdd, r%st%qdd, skip)
+    if (allocated(r%contact)) then
+      if (r%contact%opt%compliant) err = max(err, compliant_error(r%contact))
+    end if
     ratio = next_step_ratio(r%sc, err)
     ok = err <= 1 .or. h <= r%sc%dt_min
     if (err > 1.25_dp .and. ok .and. .not. r%floor_told) then
@@ -670,6 +671,40 @@ contains
         if (c%set%act(k)%elem > 0) skip(r%model%conn(:, c%set%act(k)%elem)) = .true.
       end do
     end subroutine touching
+
+    !> depth_error of each pair in compliant contact: its constraints' normal acceleration
+    !> changes (the node's less its target point's) and depths, each weighted by its spring
+    !> k A_n, so that the pair's force is judged (the vibrations of a plate's nodes on their
+    !> springs, which move no force overall, held a plate landing flat to the shortest step).
+    !> A depth is the gap's, or the one its normal speed v would reach on the spring,
+    !> v sqrt(rho h / k), where deeper (in the step a node comes in it is still a sliver)
+    real(dp) function compliant_error(c) result(e)
+      type(contact_t), intent(in) :: c
+      real(dp) :: change(c%npairs), depth(c%npairs), da(3), dv(3), w
+      integer :: k, j, i
+      change = 0; depth = 0
+      do k = 1, c%set%nact
+        associate (a => c%set%act(k), b => r%model%body(r%model%node_body(c%set%act(k)%node)))
+          i = dof(a%node, 1)
+          da = r%st%qdd(i:i + 2) - before%qdd(i:i + 2)
+          dv = r%st%qd(i:i + 2)
+          if (a%elem > 0) then
+            do j = 1, size(r%model%conn, 1)
+              i = dof(r%model%conn(j, a%elem), 1)
+              da = da - a%shp(j)*(r%st%qdd(i:i + 2) - before%qdd(i:i + 2))
+              dv = dv - a%shp(j)*r%st%qd(i:i + 2)
+            end do
+          else
+            dv = dv - c%obstacle(-c%pair(2, a%pair))%velocity
+          end if
+          w = 1/c%opt%compliance(a%node)
+          change(a%pair) = change(a%pair) + w*dot_product(a%n, da)
+          depth(a%pair) = depth(a%pair) + w*max(-a%gap, abs(dot_product(a%n, dv))* &
+                                                sqrt(b%density*b%thickness/r%deck%contact%stiffness))
+        end associate
+      end do
+      e = depth_error(r%sc, r%nm, change, depth)
+    end function compliant_error
   end function step_accepted
 
   !> Whether the step's energy is within the tolerance while no contact is active
@@ -1034,18 +1069,24 @@ contains
   !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
   !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
   !> and it may only grow with a dissipative scheme (stay, with a conservative one)
-  subroutine watch_energy(r, rest, nact_start)
+  subroutine watch_energy(r, rest, start)
     type(run_t), intent(inout) :: r
     real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
-    integer, intent(in), optional :: nact_start   !< contacts active at the step's start
+    type(contact_t), intent(in), optional :: start   !< the contact at the step's start
     if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t; r%dt_made = r%nm%dt
-      r%made_contacts = 0   ! (those of a step that released them acted in it too)
-      if (allocated(r%contact)) r%made_contacts = r%contact%set%nact
-      if (present(nact_start)) r%made_contacts = max(r%made_contacts, nact_start)
+      r%made_contacts = 0; r%made_between = 0   ! (those of a step that released them acted in it too)
+      if (allocated(r%contact)) call count_active(r%contact)
+      if (present(start)) call count_active(start)
     end if
     r%rest_last = rest
     r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
+  contains
+    subroutine count_active(c)
+      type(contact_t), intent(in) :: c
+      r%made_contacts = max(r%made_contacts, c%set%nact)
+      r%made_between = max(r%made_between, count(c%pair(2, c%set%act(1:c%set%nact)%pair) > 0))
+    end subroutine count_active
   end subroutine watch_energy
 
   !> Keep the least thickness stretch of the run's states (thinnest)
@@ -1127,7 +1168,7 @@ contains
       made = rtoa(r%made_max)//' J (the bodies held at most '//rtoa(r%e_scale)//' J)'
     end if
     why = 'a node that came deep into a target in one step'
-    if (allocated(r%contact)) then   ! (closed shells have no rim)
+    if (allocated(r%contact) .and. r%made_between > 0) then   ! (closed shells have no rim)
       if (any(r%contact%rim)) why = 'a shell''s edge that passed between the other''s nodes (casca has '// &
                                     'no edge-to-edge contact; with one pass, test the edge''s body as impactor or '// &
                                     'set passes = 2), or a node that came deep into a target in one step'

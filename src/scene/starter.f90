@@ -146,6 +146,9 @@ contains
     do b = 1, model%nbody
       call body_lines(model, b, f(b), out)
     end do
+    write (out, '(a)') 'scene size '//rtoa(model%length)//' m: the diagonal of the box around '// &
+      'every node at the start, the length that &run tolerance (without tolerance_length), '// &
+      'newton_tol and &contact tolerance are relative to'
     if (deck%run%analysis == 'dynamic') call step_line(deck, model, f, out)
     call memory_line(model, out)
     if (deck%run%analysis == 'dynamic') call time_line(deck, model, out)

@@ -20,7 +20,7 @@ module casca_step_control
   use casca_time_scheme, only: scheme_t
   implicit none
   private
-  public :: step_control_t, local_error, energy_error, next_step_ratio
+  public :: step_control_t, local_error, depth_error, energy_error, next_step_ratio
 
   type :: step_control_t
     real(dp) :: tol = 0           !< <= 0: fixed steps (the deck's dt, halved on failure)
@@ -52,6 +52,24 @@ contains
     end do
     err = ts%error_coefficient()*ts%dt**2*e/(sc%tol*sc%length)
   end function local_error
+
+  !> A compliant contact's error over the tolerance: c dt^2 |change| / depth of each pair in
+  !> contact (its constraints' normal acceleration changes over the step and their depths,
+  !> weighted alike), against tol, not over the scene's size: the contact force is the
+  !> penetration's, so its error, and the impulse's, is relative to that depth (a ring thrown
+  !> onto a compliant floor, depth 0.16 mm in a 0.2 m scene, took the same 43 steps at
+  !> tolerances 1e-3 and 1e-4, 1.8% off in momentum)
+  pure real(dp) function depth_error(sc, ts, change, depth) result(err)
+    type(step_control_t), intent(in) :: sc
+    type(scheme_t), intent(in) :: ts
+    real(dp), intent(in) :: change(:), depth(:)
+    integer :: p
+    err = 0
+    do p = 1, size(change)
+      if (depth(p) > 0) err = max(err, abs(change(p))/depth(p))
+    end do
+    err = ts%error_coefficient()*ts%dt**2*err/sc%tol
+  end function depth_error
 
   !> The energy a step made over the tolerance times the energy the bodies hold (scale)
   pure real(dp) function energy_error(sc, made, scale) result(err)
