@@ -2,7 +2,7 @@
 !> step, account, write). Exit codes: 0 done, 2 bad input, 3 the solver could not go on.
 module casca_run
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use casca_kinds, only: dp
+  use casca_kinds, only: dp, pi
   use casca_error, only: error_t
   use casca_deck, only: deck_t, read_deck, unset, add_problem, default_newton_tol
   use casca_sanity, only: check_deck
@@ -675,14 +675,15 @@ contains
     !> depth_error of each pair in compliant contact: its constraints' normal acceleration
     !> changes (the node's less its target point's) and depths, each weighted by its spring
     !> k A_n, so that the pair's force is judged (the vibrations of a plate's nodes on their
-    !> springs, which move no force overall, held a plate landing flat to the shortest step).
-    !> A depth is the gap's, or the one its normal speed v would reach on the spring,
-    !> v sqrt(rho h / k), where deeper (in the step a node comes in it is still a sliver)
+    !> springs, which move no force overall, held a plate landing flat to the shortest step),
+    !> and its contact time pi sqrt(rho h / k). A depth is the gap's, or the one its normal
+    !> speed v would reach on the spring, v sqrt(rho h / k), where deeper (in the step a node
+    !> comes in it is still a sliver)
     real(dp) function compliant_error(c) result(e)
       type(contact_t), intent(in) :: c
-      real(dp) :: change(c%npairs), depth(c%npairs), da(3), dv(3), w
+      real(dp) :: change(c%npairs), depth(c%npairs), tc(c%npairs), da(3), dv(3), w, root
       integer :: k, j, i
-      change = 0; depth = 0
+      change = 0; depth = 0; tc = 0
       do k = 1, c%set%nact
         associate (a => c%set%act(k), b => r%model%body(r%model%node_body(c%set%act(k)%node)))
           i = dof(a%node, 1)
@@ -699,11 +700,12 @@ contains
           end if
           w = 1/c%opt%compliance(a%node)
           change(a%pair) = change(a%pair) + w*dot_product(a%n, da)
-          depth(a%pair) = depth(a%pair) + w*max(-a%gap, abs(dot_product(a%n, dv))* &
-                                                sqrt(b%density*b%thickness/r%deck%contact%stiffness))
+          root = sqrt(b%density*b%thickness/r%deck%contact%stiffness)   ! (1 / omega on the spring)
+          depth(a%pair) = depth(a%pair) + w*max(-a%gap, abs(dot_product(a%n, dv))*root)
+          tc(a%pair) = max(tc(a%pair), pi*root)
         end associate
       end do
-      e = depth_error(r%sc, r%nm, change, depth)
+      e = depth_error(r%sc, r%nm, change, depth, tc)
     end function compliant_error
   end function step_accepted
 
