@@ -695,7 +695,7 @@ contains
               da = da - a%shp(j)*(r%st%qdd(i:i + 2) - before%qdd(i:i + 2))
               dv = dv - a%shp(j)*r%st%qd(i:i + 2)
             end do
-          else
+          else if (c%pair(2, a%pair) < 0) then
             dv = dv - c%obstacle(-c%pair(2, a%pair))%velocity
           end if
           w = 1/c%opt%compliance(a%node)
