@@ -135,6 +135,18 @@ if h.shape == ref.shape:
           np.max(np.abs(t5 - ref) / scale) if t5.shape == ref.shape else np.inf, 1e-12)
 ck.record("the folder's lock is gone after the last run", not os.path.exists(os.path.join(kill_out, "casca.lock")))
 
+# --- a restart from a finished run's own checkpoint: its time is t_end but for the rounding
+# of a sum of 80 steps (4.0000000000000036e-3), and it is accepted, takes no step and leaves
+# the history as it was (it was refused as 'outside [0, t_end]', validator 2026-11-29)
+done_out = os.path.join(work, "finished")
+p = run([casca, "run", deck("finished", t_end="4.0e-3", out=done_out), "-q"])
+before = open(os.path.join(done_out, "history.dat")).read() if p.returncode == 0 else ""
+p = run([casca, "run", deck("finished", t_end="4.0e-3", out=done_out), "-q",
+         "--restart", os.path.join(done_out, "checkpoint.h5")])
+ck.record("restart from a finished run's checkpoint (t_end + rounding): exit 0, history.dat unchanged",
+          p.returncode == 0 and before != "" and open(os.path.join(done_out, "history.dat")).read() == before,
+          first_line(p))
+
 # --- a restart into a new folder (--out elsewhere): it carries on the checkpoint folder's
 # history, which ends as the uninterrupted run's (1e-12), and leaves the old folder as it was
 part_out, new_out = os.path.join(work, "part"), os.path.join(work, "moved")

@@ -37,7 +37,9 @@ distorted      one straight-sided element, legs 0.1 m, its centroid node moved b
                gives 0.38 (warned: below 0.5), d = 0 gives 1 (not warned); 1e-4.
 never          two rings closing at 6 m/s: no 'never meets' warning; ring1 moving away
                (-10 m/s against ring2's 4): warned; the same under gravity: not warned (it
-               may bring them together).
+               may bring them together); four rings in a row, pairs 1-2, 2-3, 3-4 listed, the
+               first thrown at the three at rest: no warning (each, once hit, meets the next;
+               pair 3-4 was warned of).
 large dt       the closing rings with dt 5e-5 s (3e-4 m per step): no warning; dt 0.05 s
                (0.3 m per step, beyond the band 1.25 h + half a sub-triangle edge < 0.13 m):
                warned, the per-step travel printed as 6 dt (1e-4).
@@ -316,6 +318,13 @@ ck.record("ring1 moving away: warned 'never meets'", code == 0 and any(
 code, out, err, b = check("apart_gravity", rings(-10.0, 5.0e-5, 1.0e-3, "0.0, -9.81, 0.0"))
 ck.record("ring1 moving away under gravity (it may bring them together): no warning",
           code == 0 and warnings(err) == [], str(warnings(err)))
+row = rings(10.0, 5.0e-5, 1.0e-3).replace("velocity = 4.0, 0.0, 0.0", "velocity = 0.0, 0.0, 0.0") + "".join(
+    f"&body name = 'ring{k}', mesh = 'file', file = '{ring}', center = {2.1 * (k - 1):.1f}, 0.0, 0.0, {STEEL}, "
+    "thickness = 0.05 /\n" for k in (3, 4)) + \
+    "&contact pairs = 'ring1', 'ring2', 'ring2', 'ring3', 'ring3', 'ring4' /\n"
+code, out, err, b = check("row", row)
+ck.record("four rings in a row, the first thrown at the three at rest: no 'never meets' warning",
+          code == 0 and not any("never meets" in w for w in warnings(err)), str(warnings(err)))
 code, out, err, b = check("large_dt", rings(10.0, 0.05, 0.1))
 m = re.search(r"'ring1' -> 'ring2' closes (\S+) m in one step", err)
 ck.record("rings closing at 6 m/s, dt 0.05 s: exit 0, warned", code == 0 and m is not None, str(warnings(err)))

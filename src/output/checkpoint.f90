@@ -166,7 +166,7 @@ contains
       bad = 'it belongs to another model'
     else if (any(fp /= model_fingerprint(model))) then
       bad = 'it belongs to another model (mesh, materials or restraints differ from the deck''s)'
-    else if (.not. (st%t >= 0 .and. st%t <= t_max)) then
+    else if (.not. (st%t >= 0 .and. st%t <= t_max*(1 + 1e-9_dp))) then   ! (a sum of steps: rounding)
       bad = 'its time is outside [0, t_end]'
     else if (st%step < 0) then
       bad = 'its step number is negative'
