@@ -7,7 +7,7 @@ module casca_run
   use casca_deck, only: deck_t, read_deck, unset, add_problem, default_newton_tol
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
-  use casca_starter, only: put_warnings, contact_time, static_warnings
+  use casca_starter, only: put_warnings, contact_time, spring_time, static_warnings
   use casca_model, only: model_t, reference_state, dof, thinnest
   use casca_assembly, only: assembly_t, assembly_setup
   use casca_linear_system, only: linear_system_t
@@ -681,7 +681,7 @@ contains
     !> comes in it is still a sliver)
     real(dp) function compliant_error(c) result(e)
       type(contact_t), intent(in) :: c
-      real(dp) :: change(c%npairs), depth(c%npairs), tc(c%npairs), da(3), dv(3), w, root
+      real(dp) :: change(c%npairs), depth(c%npairs), tc(c%npairs), da(3), dv(3), w, tb
       integer :: k, j, i
       change = 0; depth = 0; tc = 0
       do k = 1, c%set%nact
@@ -700,9 +700,9 @@ contains
           end if
           w = 1/c%opt%compliance(a%node)
           change(a%pair) = change(a%pair) + w*dot_product(a%n, da)
-          root = sqrt(b%density*b%thickness/r%deck%contact%stiffness)   ! (1 / omega on the spring)
-          depth(a%pair) = depth(a%pair) + w*max(-a%gap, abs(dot_product(a%n, dv))*root)
-          tc(a%pair) = max(tc(a%pair), pi*root)
+          tb = spring_time(b, r%deck%contact%stiffness)   ! (pi / omega on the spring)
+          depth(a%pair) = depth(a%pair) + w*max(-a%gap, abs(dot_product(a%n, dv))*tb/pi)
+          tc(a%pair) = max(tc(a%pair), tb)
         end associate
       end do
       e = depth_error(r%sc, r%nm, change, depth, tc)

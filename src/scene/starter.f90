@@ -22,10 +22,10 @@
 !>             times it: tests/test_starter_freq.f90)
 !>   step      explicit stable step ~ 2 / omega_max of the two; estimates, not eigenvalues
 module casca_starter
-  use casca_kinds, only: dp
+  use casca_kinds, only: dp, pi
   use casca_mesh, only: nen
   use casca_deck, only: deck_t, unset
-  use casca_model, only: model_t, dof, element_dofs, area_points, element_area
+  use casca_model, only: model_t, body_t, dof, element_dofs, area_points, element_area
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
   use casca_strings, only: itoa, rtoa, vtoa, count_of
@@ -36,7 +36,7 @@ module casca_starter
   use casca_sanity, only: bytes_per_element
   implicit none
   private
-  public :: body_facts_t, body_facts, starter_report, thickness_frequency, put_warnings, contact_time
+  public :: body_facts_t, body_facts, starter_report, thickness_frequency, put_warnings, contact_time, spring_time
   public :: static_warnings
 
   !> Below this element quality a warning names the element: the area scale of its map then
@@ -236,8 +236,8 @@ contains
       rtoa(dt*f(b)%c/f(b)%l_min)//' smallest elements per step (body '''//model%body(b)%name// &
       '''); at '//itoa(nint(steps_per_period))//' steps per period dt follows vibrations up to '// &
       rtoa(1/(steps_per_period*dt))//' Hz, membrane waves go up to ~ '// &
-      rtoa(f(b)%omega_m/(2*acos(-1._dp)))//' Hz, the thickness stretch to ~ '// &
-      rtoa(maxval(f%omega_t)/(2*acos(-1._dp)))//' Hz (the implicit step stays stable; '// &
+      rtoa(f(b)%omega_m/(2*pi))//' Hz, the thickness stretch to ~ '// &
+      rtoa(maxval(f%omega_t)/(2*pi))//' Hz (the implicit step stays stable; '// &
       damping()//')'
     if (deck%contact%stiffness == unset) return
     tc = contact_time(deck, model, b)
@@ -278,12 +278,20 @@ contains
     contact_time = huge(1._dp); b = 1
     if (deck%contact%stiffness == unset) return
     do k = 1, model%nbody
-      t = acos(-1._dp)*sqrt(model%body(k)%density*model%body(k)%thickness/deck%contact%stiffness)
+      t = spring_time(model%body(k), deck%contact%stiffness)
       if (t < contact_time) then
         contact_time = t; b = k
       end if
     end do
   end function contact_time
+
+  !> How long a shell of body bd stays on a rigid surface of this compliance: half the period
+  !> of its mass per area rho h on the spring per area, pi sqrt(rho h / stiffness)
+  pure real(dp) function spring_time(bd, stiffness)
+    type(body_t), intent(in) :: bd
+    real(dp), intent(in) :: stiffness
+    spring_time = pi*sqrt(bd%density*bd%thickness/stiffness)
+  end function spring_time
 
   !> The equations' size: unknowns, the matrix entries the elements hand to the solver (each
   !> element's lower triangle of free pairs, assembly.f90), and the memory sanity.f90 budgets
