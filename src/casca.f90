@@ -115,7 +115,8 @@ contains
     end do
     write (u, '(a)') '  casca COMMAND --help                               the options of a command', &
       '  casca --help | --version', &
-      '', 'exit codes: 0 done, 2 bad input, 3 the solver could not go on (last state kept)'
+      '', 'exit codes: 0 done, 2 bad input, 3 the solver could not go on (last state kept),', &
+      '  4 stopped by a signal (state kept)'
   end subroutine usage
 
   !> casca COMMAND --help (and casca help COMMAND): the command's whole help text, on stdout
@@ -175,9 +176,11 @@ contains
         '  plots.gp, *.png             time-history plots (gnuplot), unless &output plots = .false.', &
         '  gnuplot.log                 gnuplot''s messages', &
         '  casca.lock                  while it runs: no second run writes into the folder', &
-        '  stopped.txt                 a run that stopped early (exit 3): when, why, where to restart', &
+        '  stopped.txt                 a run that stopped early (exit 3, 4): when, why, where to restart', &
         'exit codes: 0 done, 2 bad input (every problem of the deck listed), 3 the solver could', &
-        '  not go on or an output could not be written (the last good state is kept)']
+        '  not go on or an output could not be written (the last good state is kept), 4 stopped', &
+        '  by SIGTERM, SIGINT or SIGUSR1 at the end of the step under way (its state is kept; under', &
+        '  mpirun send SIGUSR1: mpirun kills its ranks a second after a SIGTERM)']
     case ('check')
       t = [character(len=hw) :: &
         'casca check DECK                                   check a deck without running it', &

@@ -77,9 +77,9 @@ def table(folder):
         return f["history"][()]
 
 
-# --- kill and restart: a run killed at several moments (kill -9 right after a checkpoint,
-# between two, during contact, SIGTERM) and restarted each time from its own checkpoint in the
-# same folder ends with the history of the uninterrupted run, in both files, to 1e-12
+# --- kill and restart: a run killed (kill -9) at several moments (right after a checkpoint,
+# between two, during contact) and restarted each time from its own checkpoint in the same
+# folder ends with the history of the uninterrupted run, in both files, to 1e-12
 ref_out = os.path.join(work, "uninterrupted")
 p = run([casca, "run", deck("ref", out=ref_out), "-q"])
 ck.record("uninterrupted run (exit 0)", p.returncode == 0, first_line(p))
@@ -87,7 +87,7 @@ ref = np.loadtxt(os.path.join(ref_out, "history.dat"))
 kill_out = os.path.join(work, "killed")
 kdeck = deck("killed", out=kill_out)
 ckpt = os.path.join(kill_out, "checkpoint.h5")
-moments = [(10, 0.0, signal.SIGKILL), (40, 0.03, signal.SIGKILL), (70, 0.11, signal.SIGTERM),
+moments = [(10, 0.0, signal.SIGKILL), (40, 0.03, signal.SIGKILL), (70, 0.11, signal.SIGKILL),
            (110, 0.07, signal.SIGKILL), (150, 0.0, signal.SIGKILL)]
 killed_at, restarts_ok, whole = [], True, []
 
@@ -116,7 +116,7 @@ for i, (after, wait, sig) in enumerate(moments):
         restarts_ok = False
         print("restart %d: exit %d: %s" % (i, proc.returncode, err_[-300:]))
 p = run([casca, "run", kdeck, "-q", "--restart", ckpt])
-ck.record("restarts after kill -9 / SIGTERM at %d moments accepted, the last ends with exit 0"
+ck.record("restarts after kill -9 at %d moments accepted, the last ends with exit 0"
           % len(moments), restarts_ok and p.returncode == 0,
           "checkpoint step and exit per kill %s; %s" % (killed_at, first_line(p)))
 ck.record("the runs were killed at different checkpoints (really interrupted)",
@@ -134,6 +134,55 @@ if h.shape == ref.shape:
     ck.le("history.h5 after the restarts equals the uninterrupted run's history.dat",
           np.max(np.abs(t5 - ref) / scale) if t5.shape == ref.shape else np.inf, 1e-12)
 ck.record("the folder's lock is gone after the last run", not os.path.exists(os.path.join(kill_out, "casca.lock")))
+
+# --- a stop signal (a batch system's time limit, Ctrl-C, SIGUSR1 sent to mpirun): the step
+# under way ends, its state is written as checkpoint and frame, stopped.txt names the signal,
+# exit 4; the restart from there ends with the uninterrupted run's history bit for bit (both
+# with reuse_factorisation = .false.: kept factors would be fresh at the restart only, and the
+# two runs would then agree to Newton's tolerance instead)
+sig_text = deck_text.replace("t_end = T_END", "t_end = 5.0e-3, reuse_factorisation = .false.")
+sig_deck = os.path.join(work, "signalled.nml")
+with open(sig_deck, "w") as f:
+    f.write(sig_text.replace("DIR", "out"))
+for ranks, sig in ((1, signal.SIGTERM), (2, signal.SIGUSR1)):
+    name = signal.Signals(sig).name
+    sig_ref = os.path.join(work, "signal_ref_%d" % ranks)
+    p = run([casca, "run", sig_deck, "-q", "--out", sig_ref], np_ranks=ranks)
+    ck.record("%s: the uninterrupted run on %d rank(s) (exit 0)" % (name, ranks), p.returncode == 0,
+              first_line(p))
+    sig_out = os.path.join(work, "signalled_%d" % ranks)
+    cmd = [casca, "run", sig_deck, "-q", "--out", sig_out]
+    if ranks > 1:   # (mpirun kills its ranks a second after a SIGTERM, and passes SIGUSR1 on)
+        cmd = ["mpirun", "-np", str(ranks)] + cmd
+    proc = subprocess.Popen(cmd, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    hist = os.path.join(sig_out, "history.dat")
+    while proc.poll() is None and (not os.path.exists(hist) or open(hist).read().count("\n") < 25):
+        time.sleep(0.01)
+    proc.send_signal(sig)
+    out_, err_ = proc.communicate(timeout=120)
+    stopped = os.path.join(sig_out, "stopped.txt")
+    said = open(stopped).read() if os.path.exists(stopped) else ""
+    ck.record("%s on %d rank(s): exit 4, stopped.txt names it" % (name, ranks),
+              proc.returncode == 4 and name in said, "exit %d; %r" % (proc.returncode, said[:120]))
+    rows = np.loadtxt(hist)
+    with h5py.File(os.path.join(sig_out, "checkpoint.h5"), "r") as f:
+        ck_step, ck_t = int(f["step"][()]), float(f["t"][()])
+    last_frame = float(re.findall(r'timestep="([^"]+)"', open(os.path.join(sig_out, "run.pvd")).read())[-1])
+    ck.record("%s: the checkpoint is the last history row's step (the regular ones are every "
+              "10 steps), and the last frame is at its time" % name,
+              ck_step == int(rows[-1, 1]) and abs(last_frame - ck_t) <= 1e-12 * ck_t,
+              "checkpoint step %d t %.17g, last row step %d, last frame t %.17g"
+              % (ck_step, ck_t, rows[-1, 1], last_frame))
+    ck.record("%s: the folder's lock is gone" % name, not os.path.exists(os.path.join(sig_out, "casca.lock")))
+    p = run([casca, "run", sig_deck, "-q", "--out", sig_out, "--restart",
+             os.path.join(sig_out, "checkpoint.h5")], np_ranks=ranks)
+    h, ref_h = np.loadtxt(hist), np.loadtxt(os.path.join(sig_ref, "history.dat"))
+    ck.record("%s: the restart ends with exit 0 and no stopped.txt" % name,
+              p.returncode == 0 and not os.path.exists(stopped), first_line(p))
+    ck.le("%s: the restarted history.dat equals the uninterrupted run's on as many ranks (max "
+          "relative to each column's size)" % name, np.max(np.abs(h - ref_h) / np.maximum(np.max(np.abs(ref_h), axis=0),
+                                                                         1e-300))
+          if h.shape == ref_h.shape else np.inf, 1e-12)
 
 # --- a restart from a finished run's own checkpoint: its time is t_end but for the rounding
 # of a sum of 80 steps (4.0000000000000036e-3), and it is accepted, takes no step and leaves

@@ -35,6 +35,7 @@ module casca_run
   use casca_plots, only: make_plots
   use casca_pair_gaps, only: pair_gap_t, pair_gaps, pair_gap_lines
   use casca_files, only: folder_of
+  use casca_stop_request, only: catch_stop_signals, stop_requested, signal_name
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_strings, only: count_of, rtoa, vtoa, ftoa, itoa
@@ -43,7 +44,7 @@ module casca_run
   private
   public :: load_scene, run_deck
 
-  integer, parameter, public :: exit_ok = 0, exit_input = 2, exit_solver = 3
+  integer, parameter, public :: exit_ok = 0, exit_input = 2, exit_solver = 3, exit_signal = 4
   !> with an error-controlled step: the energy's cap (run_t%dt_cap) doubles after this many of
   !> its lengths
   real(dp), parameter :: cap_hold = 20
@@ -231,6 +232,7 @@ contains
     type(run_t), allocatable :: r   ! (large: MUMPS structures)
     allocate (r)
     r%quiet = quiet; r%restart = restart
+    call catch_stop_signals()   ! (from here a signal stops the run at a step's end, kept)
     call run_setup(r, path, out_dir)
     if (r%code == exit_ok) then
       if (r%deck%run%analysis == 'static') then
@@ -320,6 +322,7 @@ contains
     !> force level); energy_cut: this step was cut for its energy once already (a half step that
     !> makes energy too is kept: a shorter one made more on a plane pushing a ring)
     logical :: guarded, energy_cut
+    integer :: sig
     character(len=:), allocatable :: why
     call dynamic_start(r, interval, next_frame, next_ckpt)
     if (r%code /= exit_ok) return
@@ -387,6 +390,10 @@ contains
         call watch_energy(r, rest, contact_before)
         call watch_thickness(r)
         if (.not. step_written(r, interval, next_frame, next_ckpt)) return
+        sig = stop_requested()
+        if (sig > 0) then
+          call stop_on_request(r, sig); return
+        end if
       end do
     end associate
     call checkpoint(r)
@@ -529,7 +536,7 @@ contains
   !> factor); a restart goes on from the checkpoint's load step.
   subroutine static_run(r)
     type(run_t), intent(inout) :: r
-    integer :: i, stabilised
+    integer :: i, stabilised, sig
     real(dp) :: next_ckpt
     associate (deck => r%deck, st => r%st)
       next_ckpt = huge(1._dp)
@@ -551,6 +558,10 @@ contains
         if (is_root() .and. .not. r%quiet) print '(a,i4,a,f6.3,a,i3,a)', 'load step', i, &
           '  factor', st%t, '  newton', r%rep%iters, &
           trim(merge('  stabilised', '            ', stabilised > 0))
+        sig = stop_requested()
+        if (sig > 0 .and. i < deck%run%load_steps) then
+          call stop_on_request(r, sig); return
+        end if
         if (st%t >= next_ckpt - 1e-9_dp .and. i < deck%run%load_steps) then
           call checkpoint(r)
           if (r%code /= exit_ok) return
@@ -983,22 +994,13 @@ contains
   subroutine give_up(r, why)
     type(run_t), intent(inout) :: r
     character(len=*), intent(in) :: why
-    type(error_t), allocatable :: e
-    character(len=:), allocatable :: where_kept, reason
+    character(len=:), allocatable :: reason
     reason = why   ! (why may be r%err's message, which the frame and checkpoint below reset)
     if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', r%st%t, &
       ' s: ', reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
     if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
-    call frame(r)
-    call checkpoint(r)
-    call r%ls%finish()
-    where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5 (restart with --restart)'
-    if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
-    call output_mark_stopped(r%out, 'this run stopped at t = '//rtoa(r%st%t)//' s of t_end = '// &
-                             rtoa(r%deck%run%t_end)//' s: '//reason//new_line('a')//where_kept)
-    call output_close(r%out, e)
-    if (is_root()) write (0, '(a)') where_kept
+    call keep_and_stop(r, reason)
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
     if (is_root() .and. squeezed(r)) then
@@ -1024,6 +1026,35 @@ contains
         any(r%contact%mu_s > r%contact%mu_d .and. .not. r%contact%v_decay > 0)
     end function sudden_static_friction
   end subroutine give_up
+
+  !> A stop signal came (stop_request): the step under way was finished; keep its state as
+  !> a frame and checkpoint and stop with exit_signal, so that --restart goes on from here
+  subroutine stop_on_request(r, sig)
+    type(run_t), intent(inout) :: r
+    integer, intent(in) :: sig
+    if (is_root()) write (0, '(a,es12.5,a)') 'casca: '//signal_name(sig)//' received; stopped at t = ', &
+      r%st%t, ' s, at the end of the step under way'
+    call keep_and_stop(r, 'stopped by '//signal_name(sig))
+    if (r%code == exit_ok) r%code = exit_signal
+  end subroutine stop_on_request
+
+  !> The run ends early: the state now as a frame and checkpoint.h5, stopped.txt saying when
+  !> and why, the files closed. r%code is exit_solver if the state could not be written.
+  subroutine keep_and_stop(r, reason)
+    type(run_t), intent(inout) :: r
+    character(len=*), intent(in) :: reason
+    type(error_t), allocatable :: e
+    character(len=:), allocatable :: where_kept
+    call frame(r)
+    call checkpoint(r)
+    call r%ls%finish()
+    where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5 (restart with --restart)'
+    if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
+    call output_mark_stopped(r%out, 'this run stopped at t = '//rtoa(r%st%t)//' s of t_end = '// &
+                             rtoa(r%deck%run%t_end)//' s: '//reason//new_line('a')//where_kept)
+    call output_close(r%out, e)
+    if (is_root()) write (0, '(a)') where_kept
+  end subroutine keep_and_stop
 
   !> Close the files, draw the plots, print the summary (and, for a dynamic run from t = 0,
   !> what it kept and the energy balance)

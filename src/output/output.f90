@@ -364,6 +364,9 @@ contains
     character(len=32) :: name
     integer :: n
     if (.not. is_root()) return
+    if (size(out%times) > 0) then   ! (a run stopped just after a frame keeps that one)
+      if (out%times(size(out%times)) == st%t) return
+    end if
     if (.not. (all(ieee_is_finite(st%q)) .and. all(ieee_is_finite(st%qd)))) then
       call fatal_error(err, 'the state at step '//itoa(st%step)//' is not finite; no frame written')
       return

@@ -1,0 +1,47 @@
+!> A request to stop the run (SIGTERM, SIGINT or SIGUSR1: a batch system's time limit, Ctrl-C,
+!> or `kill -USR1` sent to mpirun, which kills its ranks about a second after a SIGTERM but
+!> passes SIGUSR1 on): caught by sysinfo.c and seen by the time loop at a step's end, where the
+!> state is whole and a checkpoint of it can be written.
+module casca_stop_request
+  use, intrinsic :: iso_c_binding, only: c_int
+  use casca_mpi, only: max_all
+  implicit none
+  private
+  public :: catch_stop_signals, stop_requested, signal_name
+
+  interface
+    subroutine c_catch_stop() bind(c, name='casca_catch_stop')
+    end subroutine c_catch_stop
+
+    function c_stop_signal() bind(c, name='casca_stop_signal') result(sig)
+      import :: c_int
+      integer(c_int) :: sig
+    end function c_stop_signal
+  end interface
+
+contains
+
+  !> From here on, a stop signal is kept for stop_requested instead of ending the process
+  subroutine catch_stop_signals()
+    call c_catch_stop()
+  end subroutine catch_stop_signals
+
+  !> The signal caught on any rank (0: none); collective, so that every rank stops at the
+  !> same step
+  integer function stop_requested() result(sig)
+    sig = c_stop_signal()
+    call max_all(sig)
+  end function stop_requested
+
+  !> 'SIGTERM' for 15, as a user knows it (Linux numbers)
+  function signal_name(sig) result(name)
+    integer, intent(in) :: sig
+    character(len=:), allocatable :: name
+    select case (sig)
+    case (2); name = 'SIGINT'
+    case (10); name = 'SIGUSR1'
+    case (15); name = 'SIGTERM'
+    case default; name = 'signal'
+    end select
+  end function signal_name
+end module casca_stop_request
