@@ -246,6 +246,8 @@ cases = [  # (name, text transformation, substrings the message must hold)
     ("a group left open", lambda s: s.replace("  interval = 5.0e-4\n", "  interval = 5.0e-4,\n", 1)
      .replace("  track_body = 'ring1', 'ring2'\n/\n", "  track_body = 'ring1', 'ring2'\n", 1),
      ["&output is not closed with '/' before the next group, at line 8", ":4:"]),
+    ("a quote left open", lambda s: s.replace("track_body = 'ring1', 'ring2'", "track_body = 'ring1, 'ring2'", 1),
+     [":7:", "&output: the quote opened here (')", "is not closed, so the group's '/' is inside the string"]),
     ("groups closed with &end", lambda s: s.replace("/\n&output", "&end\n&output", 1),
      ["&run is closed with &end (line 3)", ":1:"]),
     ("names making one history column", lambda s: s.replace("'ring1'", "'ring 1'").replace("'ring2'", "'ring_1'"),

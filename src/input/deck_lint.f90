@@ -115,7 +115,11 @@ contains
       if (group_ends(s)) exit
     end do
     if (.not. group_ends(s)) then   ! (the read would run into the next group: keys by the dozen)
-      if (i > size(text)) then
+      if (group_end(s) < 0) then   ! (a quote left open takes in the '/' and what follows)
+        call report(lineof(-group_end(s)), '&'//group//': the quote opened here ('// &
+                    trim(adjustl(text(lineof(-group_end(s)))(colof(-group_end(s)):)))// &
+                    ') is not closed, so the group''s ''/'' is inside the string')
+      else if (i > size(text)) then
         call report(first, '&'//group//' is not closed with ''/'' before the end of the deck')
       else if (lower(adjustl(text(i))) == '&end') then
         call report(first, '&'//group//' is closed with &end (line '//itoa(i)//'), which casca '// &
@@ -345,20 +349,38 @@ contains
   !> the text holds a '/' outside quotes (end of the group)
   pure logical function group_ends(s)
     character(len=*), intent(in) :: s
+    group_ends = group_end(s) > 0
+  end function group_ends
+
+  !> Where in s (a group's text) its '/' is, outside quotes; 0 if none, and then -k if a
+  !> quote opened at k is still open at the end (a '/' after it is inside the string)
+  pure integer function group_end(s) result(at)
+    character(len=*), intent(in) :: s
     character(len=1) :: q
-    integer :: i
-    q = ' '
-    group_ends = .false.
+    integer :: i, opened
+    logical :: doubled
+    q = ' '; opened = 0; doubled = .false.
     do i = 1, len(s)
-      if (q /= ' ') then
-        if (s(i:i) == q) q = ' '
+      if (doubled) then   ! (the second of a doubled quote, 'it''s': a quote inside)
+        doubled = .false.
+      else if (q /= ' ') then
+        if (s(i:i) == q) then
+          q = ' '
+          if (i < len(s)) then
+            if (s(i + 1:i + 1) == s(i:i)) then
+              q = s(i:i); doubled = .true.
+            end if
+          end if
+        end if
       else if (s(i:i) == "'" .or. s(i:i) == '"') then
-        q = s(i:i)
+        q = s(i:i); opened = i
       else if (s(i:i) == '/') then
-        group_ends = .true.; return
+        at = i; return
       end if
     end do
-  end function group_ends
+    at = 0
+    if (q /= ' ') at = -opened
+  end function group_end
 
   !> ' (did you mean ''x''?)' for the nearest key of the group; a key of other groups named
   !> as theirs (a body's pressure was met with "did you mean 'pressure'?"); else the nearest
