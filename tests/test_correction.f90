@@ -6,7 +6,8 @@
 !>   - the angular momentum changes by exactly the moment of the impulses,
 !>     sum_k nu_k (x_imp - x_target(xi_k)) x n_k (zero when the two points coincide);
 !>   - the kinetic energy drops by exactly -1/2 sum_k nu_k w_k (w: the normal relative
-!>     velocities before), and never rises.
+!>     velocities before), and never rises; the per-row losses the correction returns (the
+!>     history's contact_loss_P) sum to that drop, computed here from the bodies' energies.
 !> A lumped-mass correction fails the third (it was 1e-3 of m v0 R on the oblique rings).
 program test_correction
   use casca_kinds, only: dp
@@ -34,7 +35,7 @@ program test_correction
   type(state_t) :: st
   type(balance_t) :: b0, b1
   type(error_t), allocatable :: err
-  real(dp), allocatable :: zero(:), nu(:), w0(:), w1(:), wa(:)
+  real(dp), allocatable :: zero(:), nu(:), loss(:), w0(:), w1(:), wa(:)
   real(dp) :: moment(3), scale, xt(3)
   integer :: i, k, added
 
@@ -54,8 +55,8 @@ program test_correction
   st%qdd = [(cos(0.11_dp*i), i=1, model%ndof)]
   call account(model, asm, st, zero, st%q, b0)
   w0 = normal_rates(st%qd)
-  allocate (nu(c%set%nact))
-  call contact_correction(ms, cache, c, model, st%qd, st%qdd, err, nu)
+  allocate (nu(c%set%nact), loss(c%set%nact))
+  call contact_correction(ms, cache, c, model, st%qd, st%qdd, err, nu, loss)
   if (allocated(err)) error stop 'correction'
   call account(model, asm, st, zero, st%q, b1)
   w1 = normal_rates(st%qd); wa = normal_rates(st%qdd)
@@ -83,6 +84,8 @@ program test_correction
                 abs((b0%kinetic - b1%kinetic) + 0.5_dp*dot_product(nu, w0))/(b0%kinetic - b1%kinetic), &
                 1e-10_dp)
   call check_true('kinetic energy does not rise', b1%kinetic <= b0%kinetic)
+  call check_le('the rows'' losses summed vs the kinetic energy drop (relative)', &
+                abs(sum(loss) - (b0%kinetic - b1%kinetic))/(b0%kinetic - b1%kinetic), 1e-10_dp)
   call ms%finish()
   call check_summary()
   call mpi_stop()

@@ -6,7 +6,11 @@ The shipped two-ring deck (examples/two_rings.nml) is run for 4 ms (contact from
 on 1 rank and on 2 ranks (one ring each). It asserts:
   - the header: the columns of the earlier versions first, in their order, then
     kinetic_ring1 kinetic_ring2 strain_ring1 strain_ring2 fcontact_ring1_ring2
-    contacts_ring1_ring2 impulse_ring1_ring2; history.h5 has the same names and values (1e-14 relative);
+    contacts_ring1_ring2 impulse_ring1_ring2 contact_loss_ring1_ring2; history.h5 has the same
+    names and values (1e-14 relative);
+  - contact_loss_ring1_ring2, the kinetic energy the velocity corrections took out, starts at
+    0, never falls (a projection in the mass metric onto the contacts takes energy out, never
+    in), and is not zero once contact is reached;
   - on every row: kinetic_ring1 + kinetic_ring2 = kinetic and strain_ring1 + strain_ring2 =
     strain to 1e-12 relative (the totals are the sums; the margin is the 16 printed digits);
     with the one pair, contacts_ring1_ring2 = contacts exactly and fcontact_ring1_ring2 =
@@ -14,15 +18,16 @@ on 1 rank and on 2 ranks (one ring each). It asserts:
   - at t = 0: kinetic_ring1 = 1/2 rho h (2 pi R W) v0^2 (rho 7700, h 0.05, R 1, W 0.2,
     v0 10 m/s) to 1e-5 relative (the mesh's cubic geometry and the element quadrature differ
     from the exact cylinder by less: measured 5e-7); kinetic_ring2 = 0 exactly (at rest);
-  - the printed `energy balance:` line: E0, kinetic, strain, work equal the history's first
-    total and last kinetic, strain, work to the 5 printed digits (5e-5 relative), the remainder
-    equals total[0] - total[-1] to the same, and its percentage of E0 equals
-    100 (1 - E/E0) from the history to 1e-3 (3 printed decimals);
+  - the printed `energy balance:` line: E0, kinetic, strain, work and the velocity
+    corrections' term equal the history's first total and last kinetic, strain, work and
+    contact_loss_ring1_ring2 to the 5 printed digits (5e-5 relative), the remainder equals
+    total[0] - total[-1] less that loss to the same, and its percentage of E0 equals
+    100 (1 - E/E0 - loss/E0) from the history to 1e-3 (3 printed decimals);
   - on 2 ranks (each ring's elements on its own rank, summed in one reduction) the per-body
     and per-pair columns equal the 1-rank run's to 1e-8 of each column's largest value (the
     bound test_scenes uses for the tracked nodes on 1 and 2 ranks);
   - bodies named 'left ring' and 'right-ring': the columns are kinetic_left_ring,
-    kinetic_right_ring, ..., impulse_left_ring_right_ring (single words of letters, digits
+    kinetic_right_ring, ..., contact_loss_left_ring_right_ring (single words of letters, digits
     and '_'), and every row has as many numbers as the header has names.
 """
 import math
@@ -43,7 +48,7 @@ OLD = ("t step kinetic strain work total px py pz Lx Ly Lz contacts fcontact new
        "neg_pivots lambda_max gap_max p1_x p1_y p1_z p1_vx p1_vy p1_vz p2_x p2_y p2_z p2_vx p2_vy "
        "p2_vz").split()
 NEW = ("kinetic_ring1 kinetic_ring2 strain_ring1 strain_ring2 fcontact_ring1_ring2 "
-       "contacts_ring1_ring2 impulse_ring1_ring2").split()
+       "contacts_ring1_ring2 impulse_ring1_ring2 contact_loss_ring1_ring2").split()
 
 deck = deck_variant(os.path.join(examples, "two_rings.nml"), os.path.join(work, "rings4.nml"),
                     t_end="0.004")
@@ -93,21 +98,30 @@ if all(c in h for c in NEW):
 
 # --- the closing energy balance
 num = r"(-?\d\.\d+E[+-]\d+)"
-m = re.search(r"energy balance: E0 = %s J, kinetic %s, strain %s, work of loads %s, removed by "
-              r"the time integrator and contact %s \((-?[\d.]+)%% of E0\)" % ((num,) * 5), p.stdout)
+m = re.search(r"energy balance: E0 = %s J, kinetic %s, strain %s, work of loads %s, taken out by the "
+              r"velocity corrections %s, removed by the time integrator and contact %s "
+              r"\((-?[\d.]+)%% of E0\)" % ((num,) * 6), p.stdout)
 ck.record("the run prints the energy balance line", m is not None,
           m.group(0) if m else p.stdout[-400:])
 if m:
-    e0, kin, strain, work_, rest = (float(m.group(i)) for i in range(1, 6))
-    pct = float(m.group(6))
+    e0, kin, strain, work_, loss, rest = (float(m.group(i)) for i in range(1, 7))
+    pct = float(m.group(7))
+    loss_h = h["contact_loss_ring1_ring2"][-1]
     for label, printed, ref in (("E0", e0, h["total"][0]), ("kinetic", kin, h["kinetic"][-1]),
-                                ("strain", strain, h["strain"][-1])):
+                                ("strain", strain, h["strain"][-1]), ("velocity corrections", loss, loss_h)):
         ck.close("energy balance: %s = history's" % label, printed, ref, 5e-5)
     ck.le("energy balance: work of loads = history's (none: 0)", abs(work_ - h["work"][-1]), 0)
-    ck.close("energy balance: remainder = total[0] - total[-1] of the history", rest,
-             h["total"][0] - h["total"][-1], 5e-5)
-    ck.le("energy balance: percentage - 100 (1 - E/E0) of the history",
-          abs(pct - 100 * (1 - h["total"][-1] / h["total"][0])), 1e-3)
+    ck.close("energy balance: remainder = total[0] - total[-1] - contact_loss of the history", rest,
+             h["total"][0] - h["total"][-1] - loss_h, 5e-5)
+    ck.le("energy balance: percentage - 100 (1 - E/E0 - loss/E0) of the history",
+          abs(pct - 100 * (1 - (h["total"][-1] + loss_h) / h["total"][0])), 1e-3)
+if "contact_loss_ring1_ring2" in h:
+    cl = h["contact_loss_ring1_ring2"]
+    ck.record("contact_loss_ring1_ring2 starts at 0 and never falls (to 1e-12 of its end)",
+              cl[0] == 0 and np.all(np.diff(cl) >= -1e-12 * cl[-1]), "end %.6g J, least step %.3g J"
+              % (cl[-1], np.diff(cl).min()))
+    ck.record("contact_loss_ring1_ring2 is not zero once contact is reached", cl[-1] > 0 and h["contacts"].max() > 0,
+              "%.6g J" % cl[-1])
 
 # --- 2 ranks: the same per-body and per-pair columns
 h2 = history(outs[2][0])
@@ -130,7 +144,8 @@ ck.record("bodies 'left ring' and 'right-ring': exit 0", p.returncode == 0,
 if p.returncode == 0:
     head = open(os.path.join(out, "history.dat")).readline().lstrip("#").split()
     want = ("kinetic_left_ring kinetic_right_ring strain_left_ring strain_right_ring "
-            "fcontact_left_ring_right_ring contacts_left_ring_right_ring impulse_left_ring_right_ring").split()
+            "fcontact_left_ring_right_ring contacts_left_ring_right_ring impulse_left_ring_right_ring "
+            "contact_loss_left_ring_right_ring").split()
     ck.record("their columns: %s" % " ".join(want), head[len(OLD):] == want, " ".join(head[len(OLD):]))
     rows = np.atleast_2d(np.loadtxt(os.path.join(out, "history.dat")))
     ck.record("every row has as many numbers as the header has names (%d)" % len(head),

@@ -175,6 +175,8 @@ module casca_contact
     logical :: follow_slip = .false., hold_slip = .false.
     ! accounts
     real(dp), allocatable :: friction_work(:)   !< per pair: dissipated by sliding so far [J]
+    !> per pair: the kinetic energy the velocity corrections took out so far (hard contact) [J]
+    real(dp), allocatable :: correction_loss(:)
     real(dp) :: obstacle_work = 0               !< done on the bodies by moving obstacles [J]
     ! per pair: the impulse on the impactor so far, as the integrator applied it, and the
     ! contact's share of M a at the start of the next step [N s, N]
@@ -222,8 +224,8 @@ contains
       end associate
     end do
     allocate (c%set%act(16), c%mu_d(c%npairs), c%mu_s(c%npairs), c%v_decay(c%npairs), &
-              c%friction_work(c%npairs))
-    c%mu_d = 0; c%mu_s = 0; c%v_decay = 0; c%friction_work = 0
+              c%friction_work(c%npairs), c%correction_loss(c%npairs))
+    c%mu_d = 0; c%mu_s = 0; c%v_decay = 0; c%friction_work = 0; c%correction_loss = 0
     c%opt%slip_floor = slip_share*model%length
     allocate (c%impulse(3, c%npairs), c%carry(3, c%npairs))
     c%impulse = 0; c%carry = 0

@@ -18,6 +18,7 @@ module casca_contact_rows
   public :: contact_generalized_force, contact_force_total, contact_nodal_fields, contact_max_gap
   public :: pair_stored_energy
   public :: constraint_nkinds, slip_force, friction_force, add_step_impulse, pair_forces, contact_force_points
+  public :: start_friction
   public :: start_carry
 
 contains
@@ -342,24 +343,28 @@ contains
   !> integrator applied it, and the moving obstacles' work from it. The step changes the
   !> momentum by dt ((1 - gamma) A_start + gamma A_end) + C^T nu: A_start the contact's share
   !> of M a at the start (the last step's, with its acceleration corrections mu: c%carry),
-  !> less the normal force of the constraints released taken out of it (newmark.f90);
+  !> less the forces (normal and friction) of the constraints released taken out of it
+  !> (newmark.f90);
   !> A_end = (F_end - alpha_m A_start)/(1 - alpha_m) with F_end the end forces (pair_forces
   !> as Newton left them: f_end); nu the velocity correction's impulses, in row order, along
   !> the normals it took (Newmark: A_end = F_end). Every normal part is along the normal of
   !> the row that applied it: nf for the forces (n but on curved obstacles under
   !> generalized-alpha, and with a lever), point_normal for the correction's (build_rows).
-  !> (dt F_end summed over the steps is off by Newton's tolerance; this is exact.)
-  subroutine add_step_impulse(c, ts, released, nu, f_end)
+  !> (dt F_end summed over the steps is off by Newton's tolerance; this is exact.) loss: the
+  !> kinetic energy the velocity correction took out, per row (contact_correction), summed
+  !> into each pair's correction_loss.
+  subroutine add_step_impulse(c, ts, released, nu, f_end, loss)
     type(contact_t), intent(inout) :: c
     type(scheme_t), intent(in) :: ts
     type(constraint_t), intent(in) :: released(:)
-    real(dp), intent(in) :: nu(:), f_end(:, :)
+    real(dp), intent(in) :: nu(:), f_end(:, :), loss(:)
     real(dp) :: j(3, c%npairs), a_end(3, c%npairs), mu(3, c%npairs), dt, g
     integer :: k, r, t
     dt = ts%dt; g = ts%gamma
     do k = 1, size(released)
       associate (a => released(k))
-        c%carry(:, a%pair) = c%carry(:, a%pair) - a%mu*point_normal(a) + a%lambda/(1 - ts%alpha_m)*a%nf
+        c%carry(:, a%pair) = c%carry(:, a%pair) - a%mu*point_normal(a) + &
+                             (a%lambda*a%nf - start_friction(a))/(1 - ts%alpha_m)
       end associate
     end do
     j = 0; mu = 0
@@ -367,6 +372,7 @@ contains
     do k = 1, c%set%nact
       associate (a => c%set%act(k))
         j(:, a%pair) = j(:, a%pair) + nu(r + 1)*point_normal(a)
+        c%correction_loss(a%pair) = c%correction_loss(a%pair) + sum(loss(r + 1:r + constraint_nkinds(a)))
         mu(:, a%pair) = mu(:, a%pair) + a%mu*point_normal(a)
         if (a%grip == stick) then
           j(:, a%pair) = j(:, a%pair) + nu(r + 2)*a%t(:, 1) + nu(r + 3)*a%t(:, 2)
@@ -457,6 +463,16 @@ contains
     real(dp) :: n(3)
     n = merge(a%n, a%nf, a%nl > 0)
   end function point_normal
+
+  !> A sliding constraint's friction force as the step's start acceleration has it (the force
+  !> fa the last step left; 0: not sliding, a sticking one's is in its rows): a constraint
+  !> released in the step takes it out of there with its normal force
+  pure function start_friction(a) result(f)
+    type(constraint_t), intent(in) :: a
+    real(dp) :: f(3)
+    f = 0
+    if (a%grip == slip) f = a%fa
+  end function start_friction
 
   !> The contact force on the constraint's node: normal and friction
   pure function node_force(c, a) result(f)

@@ -916,7 +916,8 @@ contains
         call output_history(r%out, r%st, r%bal, c%set%nact, contact_force_total(c), newton, &
                             max(pen, 0._dp), r%rep%neg_pivots, lmax, gmax, &
                             pair_normal_force(c), pair_active_count(c), norm2(c%impulse, dim=1), r%err, &
-                            pair_tangential_force(c), c%friction_work, c%obstacle_work, pair_stored_energy(c))
+                            pair_tangential_force(c), c%friction_work, c%obstacle_work, &
+                            merge(pair_stored_energy(c), c%correction_loss, c%opt%compliant))
       end associate
     else
       call output_history(r%out, r%st, r%bal, 0, 0._dp, newton, 0._dp, r%rep%neg_pivots, 0._dp, 0._dp, &
@@ -1092,7 +1093,7 @@ contains
         print '(a)', balance_summary(r%bal0, r%bal, model%length, any(model%fixed) .or. &
                                      any(r%fext /= 0) .or. size(deck%obstacles) > 0 .or. &
                                      any(model%pressure /= 0))   ! (issue 17)
-        print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact))
+        print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact, corrections=.true.))
       end if
       ! the mesh indicator of the last state, per body (issue 18)
       lines = output_indicator_lines(r%out, model, r%st)
@@ -1238,10 +1239,12 @@ contains
   end subroutine warn_energy
 
   !> The energy balance's terms that the scene has: friction's, moving obstacles', a
-  !> compliant contact's
-  function balance_terms(deck, contact) result(terms)
+  !> compliant contact's; with corrections, a hard contact's velocity corrections' (the
+  !> printed balance: a step's energy is judged with them in the remainder, as it was tuned)
+  function balance_terms(deck, contact, corrections) result(terms)
     type(deck_t), intent(in) :: deck
     type(contact_t), intent(in), optional :: contact
+    logical, intent(in), optional :: corrections
     type(energy_term_t), allocatable :: terms(:)
     allocate (terms(0))
     if (.not. present(contact)) return
@@ -1250,8 +1253,12 @@ contains
     if (moving_obstacles(deck, .true.)) &
       terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work, &
                                                           source=.true.)]
-    if (contact%opt%compliant) terms = [terms, energy_term_t('held in the contact stiffness', &
-                                                         sum(pair_stored_energy(contact)))]
+    if (contact%opt%compliant) then
+      terms = [terms, energy_term_t('held in the contact stiffness', sum(pair_stored_energy(contact)))]
+    else if (present(corrections)) then
+      if (corrections) terms = [terms, energy_term_t('taken out by the velocity corrections', &
+                                                     sum(contact%correction_loss))]
+    end if
   end function balance_terms
 
   logical function moving_obstacles(deck, use_contact)

@@ -108,12 +108,14 @@ contains
       ! trapezoidal rule: kinetic energy 0.03% off in that step, 14% later). With friction,
       ! the stick/slip state, the stick multipliers and their corrections, the slip
       ! direction; then the work summed so far (friction per pair, moving obstacles); last
-      ! per pair the impulse so far and the start force of the next step (rows.f90); last
-      ! friction's start force per constraint (friction.f90).
+      ! per pair the impulse so far and the start force of the next step (rows.f90); then
+      ! friction's start force per constraint (friction.f90), the depths held, and per pair
+      ! the kinetic energy the velocity corrections took out so far.
       associate (a => contact%set%act(1:nact))
         ints = [level, nact, (a(k)%node, a(k)%pair, a(k)%elem, a(k)%side, a(k)%face, a(k)%grip, k=1, nact)]
         reals = [a%lambda, a%mu, (a(k)%xi, a(k)%lt, a(k)%mut, a(k)%s, k=1, nact), contact%friction_work, &
-                 contact%obstacle_work, contact%impulse, contact%carry, (a(k)%fa, k=1, nact), a%hold]
+                 contact%obstacle_work, contact%impulse, contact%carry, (a(k)%fa, k=1, nact), a%hold, &
+                 contact%correction_loss]
       end associate
     else
       ints = [level, 0]
@@ -210,8 +212,8 @@ contains
     end if
     ! 7 integers (node, pair, elem, side, faces, grip) and 2 + 9 reals (lambda, mu; xi, lt,
     ! mut, s) per constraint, then the works (npairs + 1), the impulses (6 npairs),
-    ! friction's start forces (3 nact) and the depths held (nact) (the last three absent from
-    ! earlier checkpoints: taken as 0); a checkpoint of casca before these were kept has
+    ! friction's start forces (3 nact), the depths held (nact) and the velocity corrections'
+    ! losses (npairs) (the last four absent from earlier checkpoints: taken as 0); a checkpoint of casca before these were kept has
     ! 2 and 1 (node, pair; lambda): it is read, point, side and faces chosen again at the
     ! restart, mu taken as 0, the works as 0
     per = 7
@@ -222,7 +224,8 @@ contains
                (size(reals) /= 11*int(nact, int64) + contact%npairs + 1 .and. &
                 size(reals) /= 11*int(nact, int64) + 7*contact%npairs + 1 .and. &
                 size(reals) /= 14*int(nact, int64) + 7*contact%npairs + 1 .and. &
-                size(reals) /= 15*int(nact, int64) + 7*contact%npairs + 1)) then
+                size(reals) /= 15*int(nact, int64) + 7*contact%npairs + 1 .and. &
+                size(reals) /= 15*int(nact, int64) + 8*contact%npairs + 1)) then
         bad = 'its contact count '//itoa(nact)//' does not match its contact data'
       end if
       if (bad == '' .and. .not. all(ieee_is_finite(reals))) bad = 'its contact forces are not finite'
@@ -300,7 +303,9 @@ contains
       end if
     end if
     with_fa = size(reals) >= 14*int(nact, int64) + 7*contact%npairs + 1   ! (friction's start forces)
-    with_hold = size(reals) == 15*int(nact, int64) + 7*contact%npairs + 1   ! (the depths held)
+    with_hold = size(reals) >= 15*int(nact, int64) + 7*contact%npairs + 1   ! (the depths held)
+    if (size(reals) == 15*int(nact, int64) + 8*contact%npairs + 1) &   ! (the corrections' loss)
+      contact%correction_loss = reals(15*nact + 7*contact%npairs + 2:)
     do k = 1, nact
       contact%set%act(k) = new_constraint(ints(3 + per*(k - 1)), ints(4 + per*(k - 1)))
       associate (a => contact%set%act(k))

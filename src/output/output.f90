@@ -48,7 +48,6 @@ module casca_output
     integer :: nbody = 0, npairs = 0    !< per-body and per-pair columns
     logical :: friction = .false.       !< the pairs' tangential forces and the friction work too
     logical :: moving = .false.         !< the work of moving obstacles too
-    logical :: compliant = .false.      !< the energy each pair's compliant contact holds too
     integer :: rows = 0
     logical :: locked = .false.         !< this run holds the folder's lock
     type(indicator_t) :: ind            !< the mesh indicator of the last frame ...
@@ -67,8 +66,9 @@ contains
   !> body's name becomes '_'), which numpy's genfromtxt(names=True) keeps as they are.
   !> With friction, then ftangent_P per pair and friction_work (dissipated by sliding); with
   !> moving obstacles, obstacle_work (done on the bodies); then, each after all the above so
-  !> that they keep their positions, with friction friction_work_P per pair and with a
-  !> compliant contact contact_energy_P per pair (what its compliance holds).
+  !> that they keep their positions, with friction friction_work_P per pair, and per pair
+  !> with a compliant contact contact_energy_P (what its compliance holds), with a hard one
+  !> contact_loss_P (the kinetic energy its velocity corrections took out).
   function history_columns(ntrack, bodies, pairs, friction, moving, compliant) result(cols)
     integer, intent(in) :: ntrack
     character(len=*), intent(in) :: bodies(:), pairs(:)
@@ -95,7 +95,11 @@ contains
                           word('friction_work')]
     if (moving) cols = [cols, word('obstacle_work')]
     if (friction) cols = [cols, (word('friction_work_'//trim(pairs(k))), k=1, size(pairs))]
-    if (compliant) cols = [cols, (word('contact_energy_'//trim(pairs(k))), k=1, size(pairs))]
+    if (compliant) then
+      cols = [cols, (word('contact_energy_'//trim(pairs(k))), k=1, size(pairs))]
+    else
+      cols = [cols, (word('contact_loss_'//trim(pairs(k))), k=1, size(pairs))]
+    end if
   contains
     pure function word(name) result(w)
       character(len=*), intent(in) :: name
@@ -127,7 +131,6 @@ contains
     out%dir = trim(dir)
     out%tracked = tracked
     out%nbody = size(bodies); out%npairs = size(pairs); out%friction = friction; out%moving = moving
-    out%compliant = compliant
     allocate (out%files(0), out%times(0))
     if (.not. is_root()) return
     if (.not. make_dir(out%dir)) then
@@ -307,7 +310,8 @@ contains
     real(dp), intent(in) :: pair_force(:), pair_impulse(:)
     integer, intent(in) :: pair_count(:)
     type(error_t), allocatable, intent(out) :: err
-    !> per pair: the friction force's magnitude, the work sliding dissipated, the compliance's energy
+    !> per pair: the friction force's magnitude, the work sliding dissipated, the compliance's
+    !> energy (hard contact: the velocity corrections' loss)
     real(dp), intent(in), optional :: pair_tangent(:), pair_friction_work(:), obstacle_work, pair_energy(:)
     real(dp), allocatable :: row(:)
     character(len=max_line) :: line
@@ -331,7 +335,7 @@ contains
     if (out%friction) row = [row, pair_tangent, sum(pair_friction_work)]
     if (out%moving) row = [row, obstacle_work]
     if (out%friction) row = [row, pair_friction_work]
-    if (out%compliant) row = [row, pair_energy]
+    if (out%npairs > 0) row = [row, pair_energy]
     write (line, '(es23.15e3,1x,i0,*(1x,es23.15e3))') row(1), st%step, row(3:)
     call cf_write(out%hist, trim(line)//new_line('a'), err)
     ! (each row to the system whole: a killed run's history.dat ends with a whole row, and a

@@ -57,7 +57,7 @@ contains
     type(newton_report_t), intent(out) :: rep
     type(error_t), allocatable, intent(out) :: err
     type(contact_t), intent(inout), optional :: contact
-    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:), f_end(:, :)
+    real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:), loss(:), f_end(:, :)
     type(constraint_t), allocatable :: before(:), released(:)
     real(dp) :: dt, g
     integer :: k, iters
@@ -110,7 +110,7 @@ contains
       end if
     end if
     if (present(contact)) then   ! (before friction turns its slip directions)
-      call add_step_impulse(contact, nm, released, nu, f_end)
+      call add_step_impulse(contact, nm, released, nu, f_end, loss)
       call friction_step_done(contact, nm, before)
     end if
     st%h_last = 0
@@ -148,10 +148,11 @@ contains
         call contact_force_points(contact, model, nm%alpha_f, q, st%q)
         f_end = pair_forces(contact)
         call contact_force_points(contact, model, nm%alpha_f, q)
-        if (allocated(nu)) deallocate (nu)
-        allocate (nu(contact_nrows(contact)))
-        nu = 0   ! (a compliant contact's velocities are the scheme's own: no correction)
-        if (.not. compliant) call contact_correction(ls%mass, ls%correction, contact, model, qd, qdd, err, nu)
+        if (allocated(nu)) deallocate (nu, loss)
+        allocate (nu(contact_nrows(contact)), loss(contact_nrows(contact)))
+        nu = 0; loss = 0   ! (a compliant contact's velocities are the scheme's own: no correction)
+        if (.not. compliant) call contact_correction(ls%mass, ls%correction, contact, model, qd, qdd, err, &
+                                                     nu, loss)
         call timer_stop(t_contact)
         if (allocated(err)) return
       end if
