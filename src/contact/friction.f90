@@ -97,12 +97,10 @@ contains
     w = 1
     if (ts%alpha_m == 0 .and. ts%alpha_f == 0) w = ts%gamma
     ! a constraint that ended in the step still acts through its start force (a rolling hoop
-    ! hands its contact from node to node): along its slip of the step before; not where the
-    ! released constraints' forces are taken out of the start acceleration (gamma < 1 or
-    ! generalized-alpha, newmark.f90)
-    do k = 1, size(before)
+    ! hands its contact from node to node): along its slip of the step before, unless the
+    ! released constraints' forces were taken out of the start acceleration
+    do k = 1, merge(0, size(before), ts%drops_released())
       associate (b => before(k))
-        if (ts%gamma < 1 .or. ts%alpha_m /= 0) exit
         if (b%grip /= slip .or. holds(c%set, b%node, b%pair)) cycle
         c%friction_work(b%pair) = c%friction_work(b%pair) - dot_product((1 - w)*b%fa, b%ut)
       end associate

@@ -232,7 +232,6 @@ contains
     type(run_t), allocatable :: r   ! (large: MUMPS structures)
     allocate (r)
     r%quiet = quiet; r%restart = restart
-    call catch_stop_signals()   ! (from here a signal stops the run at a step's end, kept)
     call run_setup(r, path, out_dir)
     if (r%code == exit_ok) then
       if (r%deck%run%analysis == 'static') then
@@ -252,6 +251,7 @@ contains
     integer :: k
     real(dp) :: cap(3)   !< the energy's cap on the steps, from a checkpoint
     character(len=300), allocatable :: far(:)
+    call catch_stop_signals()   ! (from here a signal stops the run at a step's end, kept)
     call load_scene(path, r%deck, r%model, r%code)
     if (r%code /= exit_ok) return
     allocate (r%ls)

@@ -59,11 +59,11 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp), allocatable :: q(:), qd(:), qdd(:), a0(:), nu(:), loss(:), f_end(:, :)
     type(constraint_t), allocatable :: before(:), released(:)
-    real(dp) :: dt, g
+    real(dp) :: dt
     integer :: k, iters
     logical :: compliant, free
 
-    g = nm%gamma; dt = nm%dt
+    dt = nm%dt
     compliant = .false.
     if (present(contact)) compliant = contact%opt%compliant
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
@@ -89,9 +89,8 @@ contains
       end if
       return
     end if
-    ! (gamma >= 1: what is left pulls back, dissipates; a compliant contact's force falls to
-    ! zero with its gap before it is released)
-    if (present(contact) .and. (g < 1 .or. nm%alpha_m /= 0) .and. .not. compliant) then
+    ! (a compliant contact's force falls to zero with its gap before it is released)
+    if (present(contact) .and. nm%drops_released() .and. .not. compliant) then
       do k = 1, size(before)
         if (.not. holds(contact%set, before(k)%node, before(k)%pair)) released = [released, before(k)]
       end do

@@ -30,6 +30,7 @@ module casca_time_scheme
     procedure :: inertia
     procedure :: predictor
     procedure :: uses_acceleration
+    procedure :: drops_released
     procedure :: update
     procedure :: moved_start
     procedure :: end_force_weight
@@ -112,6 +113,15 @@ contains
     class(scheme_t), intent(in) :: s
     uses_acceleration = abs((1 - s%alpha_m)*(0.5_dp/s%beta - 1) - s%alpha_m) > 1e-12_dp
   end function uses_acceleration
+
+  !> Whether a contact released in a step has its force (friction with it) taken out of the
+  !> step's start acceleration, which is then taken again (newmark.f90): where what is left
+  !> would push, gamma < 1 or generalized-alpha; with gamma >= 1 (the thesis' 1.5) it pulls
+  !> back and dissipates, and stays
+  elemental logical function drops_released(s)
+    class(scheme_t), intent(in) :: s
+    drops_released = s%gamma < 1 .or. s%alpha_m /= 0
+  end function drops_released
 
   !> Newmark's relations: the end acceleration and velocity of the step q -> q1 from its
   !> start (q, v, a)
