@@ -72,6 +72,14 @@ def ckpt_step(path):
         return -1
 
 
+def max_rel(h, ref):
+    """The largest difference of two histories relative to each of ref's columns' size (inf
+    when their shapes differ)"""
+    if h.shape != ref.shape:
+        return np.inf
+    return np.max(np.abs(h - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300))
+
+
 def table(folder):
     with h5py.File(os.path.join(folder, "history.h5"), "r") as f:
         return f["history"][()]
@@ -127,12 +135,10 @@ h = np.loadtxt(os.path.join(kill_out, "history.dat"))
 ck.record("history.dat after the restarts has the uninterrupted run's steps",
           h.shape == ref.shape and np.array_equal(h[:, 1], ref[:, 1]), "%s vs %s" % (h.shape, ref.shape))
 if h.shape == ref.shape:
-    scale = np.maximum(np.max(np.abs(ref), axis=0), 1e-300)
     ck.le("history.dat equals the uninterrupted run's (max relative to each column's size)",
-          np.max(np.abs(h - ref) / scale), 1e-12)
-    t5 = table(kill_out)
+          max_rel(h, ref), 1e-12)
     ck.le("history.h5 after the restarts equals the uninterrupted run's history.dat",
-          np.max(np.abs(t5 - ref) / scale) if t5.shape == ref.shape else np.inf, 1e-12)
+          max_rel(table(kill_out), ref), 1e-12)
 ck.record("the folder's lock is gone after the last run", not os.path.exists(os.path.join(kill_out, "casca.lock")))
 
 # --- a stop signal (a batch system's time limit, Ctrl-C, SIGUSR1 sent to mpirun): the step
@@ -180,9 +186,7 @@ for ranks, sig in ((1, signal.SIGTERM), (2, signal.SIGUSR1)):
     ck.record("%s: the restart ends with exit 0 and no stopped.txt" % name,
               p.returncode == 0 and not os.path.exists(stopped), first_line(p))
     ck.le("%s: the restarted history.dat equals the uninterrupted run's on as many ranks (max "
-          "relative to each column's size)" % name, np.max(np.abs(h - ref_h) / np.maximum(np.max(np.abs(ref_h), axis=0),
-                                                                         1e-300))
-          if h.shape == ref_h.shape else np.inf, 1e-12)
+          "relative to each column's size)" % name, max_rel(h, ref_h), 1e-12)
 
 # --- a restart from a finished run's own checkpoint: its time is t_end but for the rounding
 # of a sum of 80 steps (4.0000000000000036e-3), and it is accepted, takes no step and leaves
@@ -212,8 +216,7 @@ def restart_into(name, label, out):
     if p.returncode == 0:
         h = np.loadtxt(os.path.join(out, "history.dat"))
         ck.le("%s: its history.dat vs the uninterrupted run's (max relative to each column's size)" % label,
-              np.max(np.abs(h - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300))
-              if h.shape == ref.shape else np.inf, 1e-12)
+              max_rel(h, ref), 1e-12)
     return p.returncode == 0
 
 
@@ -268,7 +271,7 @@ ck.record("the first run's history.dat has no NUL byte and all %d rows" % len(re
           b"\0" not in raw and hl.shape == ref.shape, str(hl.shape))
 if hl.shape == ref.shape:
     ck.le("the first run's history equals the uninterrupted run's (relative)",
-          np.max(np.abs(hl - ref) / np.maximum(np.max(np.abs(ref), axis=0), 1e-300)), 1e-12)
+          max_rel(hl, ref), 1e-12)
 dead = subprocess.Popen(["true"])
 dead.wait()
 with open(os.path.join(lock_out, "casca.lock"), "w") as f:

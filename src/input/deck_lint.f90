@@ -99,7 +99,7 @@ contains
     integer :: i, j, k, n, p, bad
     character(len=1) :: t, q
     logical :: done
-    integer :: nval, key_line
+    integer :: nval, key_line, open_at
     logical :: indexed, comma   !< comma: the last item was a comma
 
     ! the group as one string (comments cut), with the line of each character
@@ -115,9 +115,10 @@ contains
       if (group_ends(s)) exit
     end do
     if (.not. group_ends(s)) then   ! (the read would run into the next group: keys by the dozen)
-      if (group_end(s) < 0) then   ! (a quote left open takes in the '/' and what follows)
-        call report(lineof(-group_end(s)), '&'//group//': the quote opened here ('// &
-                    trim(adjustl(text(lineof(-group_end(s)))(colof(-group_end(s)):)))// &
+      open_at = -group_end(s)   ! (a quote left open takes in the '/' and what follows)
+      if (open_at > 0) then
+        call report(lineof(open_at), '&'//group//': the quote opened here ('// &
+                    trim(adjustl(text(lineof(open_at))(colof(open_at):)))// &
                     ') is not closed, so the group''s ''/'' is inside the string')
       else if (i > size(text)) then
         call report(first, '&'//group//' is not closed with ''/'' before the end of the deck')

@@ -213,9 +213,9 @@ contains
     ! 7 integers (node, pair, elem, side, faces, grip) and 2 + 9 reals (lambda, mu; xi, lt,
     ! mut, s) per constraint, then the works (npairs + 1), the impulses (6 npairs),
     ! friction's start forces (3 nact), the depths held (nact) and the velocity corrections'
-    ! losses (npairs) (the last four absent from earlier checkpoints: taken as 0); a checkpoint of casca before these were kept has
-    ! 2 and 1 (node, pair; lambda): it is read, point, side and faces chosen again at the
-    ! restart, mu taken as 0, the works as 0
+    ! losses (npairs) (the last four absent from earlier checkpoints: taken as 0); a
+    ! checkpoint of casca before these were kept has 2 and 1 (node, pair; lambda): it is read,
+    ! point, side and faces chosen again at the restart, mu taken as 0, the works as 0
     per = 7
     if (bad == '' .and. present(contact)) then
       if (size(ints) == 2 + 2*int(nact, int64) .and. size(reals) == nact) then
