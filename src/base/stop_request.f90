@@ -3,7 +3,7 @@
 !> passes SIGUSR1 on): caught by sysinfo.c and seen by the time loop at a step's end, where the
 !> state is whole and a checkpoint of it can be written.
 module casca_stop_request
-  use, intrinsic :: iso_c_binding, only: c_int
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use casca_mpi, only: max_all
   implicit none
   private
@@ -17,6 +17,12 @@ module casca_stop_request
       import :: c_int
       integer(c_int) :: sig
     end function c_stop_signal
+
+    subroutine c_signal_name(sig, name) bind(c, name='casca_signal_name')
+      import :: c_int, c_char
+      integer(c_int), value :: sig
+      character(kind=c_char) :: name(16)
+    end subroutine c_signal_name
   end interface
 
 contains
@@ -33,15 +39,16 @@ contains
     call max_all(sig)
   end function stop_requested
 
-  !> 'SIGTERM' for 15, as a user knows it (Linux numbers)
+  !> 'SIGTERM' for SIGTERM's number, as a user knows it (the C library's macros: the numbers
+  !> differ between systems)
   function signal_name(sig) result(name)
     integer, intent(in) :: sig
     character(len=:), allocatable :: name
-    select case (sig)
-    case (2); name = 'SIGINT'
-    case (10); name = 'SIGUSR1'
-    case (15); name = 'SIGTERM'
-    case default; name = 'signal'
-    end select
+    character(kind=c_char) :: buf(16)
+    integer :: n
+    call c_signal_name(int(sig, c_int), buf)
+    n = findloc(buf, c_null_char, dim=1) - 1
+    allocate (character(len=n) :: name)
+    name = transfer(buf(1:n), name)
   end function signal_name
 end module casca_stop_request

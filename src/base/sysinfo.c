@@ -63,3 +63,13 @@ int casca_stop_signal(void)
 {
     return stop_signal;
 }
+
+/* its name as a user knows it, into name (16 characters, NUL-ended): the numbers differ
+ * between systems, the macros do not */
+void casca_signal_name(int sig, char *name)
+{
+    const char *s = sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" :
+                    sig == SIGUSR1 ? "SIGUSR1" : "signal";
+    strncpy(name, s, 15);
+    name[15] = '\0';
+}
