@@ -86,6 +86,7 @@ module casca_run
     !> the energy a step made (the remainder of the balance fell): the largest, when, and the
     !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
     real(dp) :: rest_last = 0, made_max = 0, t_made = 0, dt_made = 0
+    real(dp) :: dt_made_before = 0              !< the free step before it, when shorter (grown back)
     real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
     integer :: made_contacts = 0
     integer :: made_between = 0                 !< of them, between bodies (not obstacles)
@@ -387,7 +388,7 @@ contains
         else if (r%level > 0 .and. rep%iters <= 3) then
           r%level = r%level - 1   ! Newton is at ease: grow back
         end if
-        call watch_energy(r, rest, contact_before)
+        call watch_energy(r, rest, contact_before, st_before%h_last)
         call watch_thickness(r)
         if (.not. step_written(r, interval, next_frame, next_ckpt)) return
         sig = stop_requested()
@@ -1103,12 +1104,17 @@ contains
   !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
   !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
   !> and it may only grow with a dissipative scheme (stay, with a conservative one)
-  subroutine watch_energy(r, rest, start)
+  subroutine watch_energy(r, rest, start, h_before)
     type(run_t), intent(inout) :: r
     real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
     type(contact_t), intent(in), optional :: start   !< the contact at the step's start
+    real(dp), intent(in), optional :: h_before   !< the step before's length if it was free, else 0
     if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
       r%made_max = r%rest_last - rest; r%t_made = r%st%t; r%dt_made = r%nm%dt
+      r%dt_made_before = 0
+      if (present(h_before) .and. r%sc%tol <= 0) then   ! (fixed steps, grown back after cuts)
+        if (h_before > 0 .and. r%nm%dt > 1.5_dp*h_before) r%dt_made_before = h_before
+      end if
       r%made_contacts = 0; r%made_between = 0   ! (those of a step that released them acted in it too)
       if (allocated(r%contact)) call count_active(r%contact)
       if (present(start)) call count_active(start)
@@ -1216,7 +1222,13 @@ contains
     ! between mid-surfaces, no node edge-on or deep)
     if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) why = why//'; or the impact''s ringing, '// &
       'which '//r%nm%describe()//' keeps undamped: rho_inf = 0.8 (generalized-alpha) damps it'
-    if (r%made_contacts == 0) then
+    if (r%made_contacts == 0 .and. r%dt_made_before > 0) then
+      ! (a hoop hopping on a floor, its steps halved to 0.25 ms: 0.23% in the step that grew
+      ! back to 0.5 ms, its strain energy alternating for ten steps after)
+      why = 'with no contact, in a step that had grown back to '//rtoa(r%dt_made)//' s after cuts to '// &
+            rtoa(r%dt_made_before)//' s: the start acceleration of the shorter steps rang in the longer '// &
+            'one; take a shorter dt (the cuts say how much shorter), or give a tolerance (&run)'
+    else if (r%made_contacts == 0) then
       why = 'with no contact, the time scheme made it over a motion its steps do not follow, '// &
             'as a spinning thin shell''s breathing under steps longer than its period (a stiff '// &
             'shell holds much energy in a small error); '
