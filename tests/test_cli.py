@@ -256,6 +256,10 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["&body ring1: thickness 1.5000E+00 m is more than half the body's size, 2.0000E+00 m", ":12:"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),
+    ("bodies outside their container", lambda s: s + "&obstacle\n name = 'jar', shape = 'sphere', point = 0.0, 0.0, 0.0,"
+     " radius = 0.3, inside = .true.\n/\n",
+     ["&obstacle jar is a container (inside = .true.), and body 'ring", "is not inside it at the start",
+      "place the body within its radius", ":%d:" % (good.count("\n") + 1)]),
     ("missing required value", lambda s: s.replace("young = 210e9, ", "", 1), ["young", "missing"]),
     ("unknown mesh kind", lambda s: s.replace("mesh = 'file'", "mesh = 'torus'", 1), ["torus", "mesh"]),
     ("unknown contact normal", lambda s: s + "&contact\n normal = 'smooth'\n/\n", ["&contact", "normal", "nodal"]),

@@ -157,13 +157,14 @@ contains
       end do
     end subroutine check_thickness
 
-    !> bodies of a contact pair that overlap at the start are refused, never ignored
+    !> bodies of a contact pair that overlap at the start are refused, never ignored: named at
+    !> the impactor body's line, or at the obstacle's (a container's body outside it)
     subroutine check_overlap()
       type(contact_t) :: probe
       real(dp), allocatable :: q(:)
-      integer :: added, k, worst
+      integer :: added, k, worst, t, line
       logical :: found
-      character(len=512) :: msg
+      character(len=:), allocatable :: msg, body, depth
       call scene_contact(deck, model, probe, found)
       if (.not. found) return
       allocate (q(model%ndof))
@@ -172,14 +173,27 @@ contains
       if (added == 0) return
       worst = minloc(probe%set%act(1:probe%set%nact)%gap, dim=1)
       k = probe%set%act(worst)%node
-      write (msg, '(a,a,a,a,a,i0,a,es10.3,a)') 'bodies ''', &
-        trim(model%body(model%node_body(k))%name), ''' and ''', &
-        trim(target_name(probe%pair(2, probe%set%act(worst)%pair))), ''' overlap at the start: node ', &
-        k - model%body(model%node_body(k))%node_first + 1, ' is ', -probe%set%act(worst)%gap, ' m inside ('
-      msg = trim(msg)//count_of(added, 'node', 'nodes')//' in all); move them apart'
-      if (probe%opt%faces) msg = trim(msg)//' (contact is between the shell faces: half of each '// &
-                             'thickness from the mid-surface)'
-      call add_problem(deck, 0, trim(msg))
+      t = probe%pair(2, probe%set%act(worst)%pair)
+      body = trim(model%body(model%node_body(k))%name)
+      depth = 'node '//itoa(k - model%body(model%node_body(k))%node_first + 1)//' is '// &
+              rtoa(-probe%set%act(worst)%gap)//' m '
+      line = deck%bodies(model%node_body(k))%line
+      if (t > 0) then
+        msg = 'bodies '''//body//''' and '''//trim(target_name(t))//''' overlap at the start: '//depth// &
+              'inside ('//count_of(added, 'node', 'nodes')//' in all); move them apart'
+      else if (deck%obstacles(-t)%inside) then
+        line = deck%obstacles(-t)%line
+        msg = '&obstacle '//trim(target_name(t))//' is a container (inside = .true.), and body '''//body// &
+              ''' is not inside it at the start: '//depth//'beyond its wall ('//count_of(added, 'node', 'nodes')// &
+              ' in all); place the body within its radius, or set inside = .false. to keep it out'
+      else
+        line = deck%obstacles(-t)%line
+        msg = 'body '''//body//''' and &obstacle '''//trim(target_name(t))//''' overlap at the start: '// &
+              depth//'inside ('//count_of(added, 'node', 'nodes')//' in all); move them apart'
+      end if
+      if (probe%opt%faces) msg = msg//' (contact is between the shell faces: half of each '// &
+                                 'thickness from the mid-surface)'
+      call add_problem(deck, line, msg)
     end subroutine check_overlap
 
     !> each pair's gap and time to contact at t = 0 (pair_gaps.f90), on rank 0
