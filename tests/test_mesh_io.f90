@@ -254,6 +254,12 @@ contains
                     '1 10 1 10' // nl // '2 1 0 10' // nl // '1' // nl // '2' // nl // '3' // nl)
     call expect_error('bad_truncated_nodes', p, ':10:', .true.)
 
+    ! Cut off in the middle of a node's line (no line end): named at that line, and said so.
+    p = tmp_dir // '/' // tag // '_cut_line.msh'
+    call write_text(p, '$MeshFormat' // nl // '4.1 0 8' // nl // '$EndMeshFormat' // nl // '$Nodes' // nl // &
+                    '1 2 1 2' // nl // '2 1 0 2' // nl // '1' // nl // '2' // nl // '0 0 0' // nl // '1 0')
+    call expect_error('bad_cut_line', p, ':10:', .true., 'the file ends in the middle of this line')
+
     p = tmp_dir // '/' // tag // '_version30.msh'
     call write_text(p, '$MeshFormat' // nl // '3.0 0 8' // nl // '$EndMeshFormat' // nl)
     call expect_error('bad_version_3_0', p, ':2:', .true.)
@@ -283,9 +289,10 @@ contains
   end subroutine test_bad_files
 
   !> read_gmsh(path) must fail with a message naming the file (and containing `where`).
-  subroutine expect_error(name, path, where, delete)
+  subroutine expect_error(name, path, where, delete, also)
     character(len=*), intent(in) :: name, path, where
     logical, intent(in) :: delete
+    character(len=*), intent(in), optional :: also   !< a phrase the message must hold too
     type(mesh_t) :: m
     type(error_t), allocatable :: err
     integer :: u, ios
@@ -298,6 +305,8 @@ contains
       call report(.false., name, 'no error', 'an error naming ' // path // where)
     else if (index(err%message, path // where) /= 1) then
       call report(.false., name, '"' // err%message // '"', 'a message starting with ' // path // where)
+    else if (present(also)) then
+      call report(index(err%message, also) > 0, name, '"' // err%message // '"', 'a message saying ' // also)
     else
       call report(.true., name, '"' // err%message // '"', '')
     end if

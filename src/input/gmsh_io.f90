@@ -940,8 +940,17 @@ contains
     type(cursor_t), intent(in) :: cur
     character(len=*), intent(in) :: msg
     character(len=16) :: ln
+    character(len=:), allocatable :: why
     write (ln, '(i0)') cur%line
-    call fatal_error(err, cur%path // ":" // trim(ln) // ": " // msg)
+    why = msg
+    ! (the line that failed is the file's last and has no end: a copy or a write cut short,
+    ! whose last number was read as another)
+    if (cur%line > 0 .and. cur%pos > len(cur%buf) .and. len(cur%buf) > 0 .and. &
+        index(msg, 'end of file') == 0) then
+      if (cur%buf(len(cur%buf):len(cur%buf)) /= achar(10)) &
+        why = msg // ' (the file ends in the middle of this line: is it cut off?)'
+    end if
+    call fatal_error(err, cur%path // ":" // trim(ln) // ": " // why)
   end subroutine fail
 
   !> At most 60 characters of a line for an error message.
