@@ -163,8 +163,8 @@ contains
       type(contact_t) :: probe
       real(dp), allocatable :: q(:)
       integer :: added, k, worst, t, line
-      logical :: found
-      character(len=:), allocatable :: msg, body, depth
+      logical :: found, container
+      character(len=:), allocatable :: msg, body, depth, nodes, who
       call scene_contact(deck, model, probe, found)
       if (.not. found) return
       allocate (q(model%ndof))
@@ -177,19 +177,22 @@ contains
       body = trim(model%body(model%node_body(k))%name)
       depth = 'node '//itoa(k - model%body(model%node_body(k))%node_first + 1)//' is '// &
               rtoa(-probe%set%act(worst)%gap)//' m '
-      line = deck%bodies(model%node_body(k))%line
+      nodes = ' ('//count_of(added, 'node', 'nodes')//' in all); '
+      container = .false.
       if (t > 0) then
-        msg = 'bodies '''//body//''' and '''//trim(target_name(t))//''' overlap at the start: '//depth// &
-              'inside ('//count_of(added, 'node', 'nodes')//' in all); move them apart'
-      else if (deck%obstacles(-t)%inside) then
-        line = deck%obstacles(-t)%line
-        msg = '&obstacle '//trim(target_name(t))//' is a container (inside = .true.), and body '''//body// &
-              ''' is not inside it at the start: '//depth//'beyond its wall ('//count_of(added, 'node', 'nodes')// &
-              ' in all); place the body within its radius, or set inside = .false. to keep it out'
+        line = deck%bodies(model%node_body(k))%line
+        who = 'bodies '''//body//''' and '''//trim(target_name(t))//''''
       else
         line = deck%obstacles(-t)%line
-        msg = 'body '''//body//''' and &obstacle '''//trim(target_name(t))//''' overlap at the start: '// &
-              depth//'inside ('//count_of(added, 'node', 'nodes')//' in all); move them apart'
+        who = 'body '''//body//''' and &obstacle '''//trim(target_name(t))//''''
+        container = deck%obstacles(-t)%inside
+      end if
+      if (container) then
+        msg = '&obstacle '//trim(target_name(t))//' is a container (inside = .true.), and body '''//body// &
+              ''' is not inside it at the start: '//depth//'beyond its wall'//nodes// &
+              'place the body within its radius, or set inside = .false. to keep it out'
+      else
+        msg = who//' overlap at the start: '//depth//'inside'//nodes//'move them apart'
       end if
       if (probe%opt%faces) msg = msg//' (contact is between the shell faces: half of each '// &
                                  'thickness from the mid-surface)'
