@@ -254,6 +254,18 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["name 'ring_1' and 'ring 1' make the same history column name 'ring_1'", ":15:"]),
     ("a thickness in another unit", lambda s: s.replace("thickness = 0.05", "thickness = 1.5", 1),
      ["&body ring1: thickness 1.5000E+00 m is more than half the body's size, 2.0000E+00 m", ":12:"]),
+    # (judged before the elements are set up: past its radius a ring turns inside out
+    # through its thickness, and was refused as a degenerate element, with no line)
+    ("a ring's thickness past its radius, in another unit", lambda s: s.replace("thickness = 0.05", "thickness = 2.5", 1),
+     ["&body ring1: thickness 2.5000E+00 m is more than half the body's size, 2.0000E+00 m", ":12:"]),
+    ("a shell thicker than twice its radius of curvature", lambda s: s.replace(
+        "name = 'ring1', mesh = 'file', file = '%s'" % ring,
+        "name = 'ring1', mesh = 'ring', radius = 1.0, width = 10.0, n_around = 8, n_across = 2", 1)
+     .replace("thickness = 0.05", "thickness = 4.5", 1),
+     ['body "ring1" turns inside out through its thickness, 4.5000E+00 m']),
+    ("time-step keys in a static deck", lambda s: s.replace("  dt = 5.0e-5, t_end = 3.0e-3\n",
+                                                            "  dt = 5.0e-5, t_end = 3.0e-3\n  analysis = 'static', tolerance = 1e-5\n", 1),
+     ["&run: tolerance is for analysis = 'dynamic'; a static run steps its load by load_steps", ":3:"]),
     ("bodies overlapping at the start", lambda s: s.replace("center = 2.06", "center = 2.04"),
      ["overlap at the start", "ring1", "ring2"]),
     ("bodies outside their container", lambda s: s + "&obstacle\n name = 'jar', shape = 'sphere', point = 0.0, 0.0, 0.0,"
@@ -306,6 +318,23 @@ for t, name in frames:
                                                "contact_force", "signed_distance"))
            and all(k in m.cell_data for k in ("body", "von_mises")))
 ck.record("meshio reads every frame: cell type 69, 80 cells x 10, 480 points, all fields", ok)
+
+# the frames' signed distance to a rigid obstacle: a plate (h 10 mm) whose lower face is 1 mm
+# above a plane has every node at the gap 1 mm (until 2026-11-29 every node showed the search
+# radius, 6.25 mm, as an obstacle's probe looked nowhere)
+gap_deck = os.path.join(work, "gap_plane.nml")
+with open(gap_deck, "w") as f:
+    f.write("&run dt = 1e-4, t_end = 1e-4 /\n&output interval = 1e-4, plots = .false. /\n"
+            "&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 2, ny = 2, center = 0.0, 0.0, 0.006,\n"
+            "  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.01 /\n"
+            "&obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, 0.0, normal = 0.0, 0.0, 1.0 /\n")
+p = run([casca, "run", gap_deck, "--out", os.path.join(work, "gap_plane_out")])
+if p.returncode == 0:
+    m = meshio.read(os.path.join(work, "gap_plane_out", "frame_00000.vtu"))
+    ck.le("signed_distance to a plane 1 mm below the plate's face: largest |sd - 1 mm| [m]",
+          np.abs(np.asarray(m.point_data["signed_distance"]).ravel() - 1e-3).max(), 1e-12)
+else:
+    ck.record("a plate 1 mm above a plane runs (exit 0)", False, p.stderr[-300:])
 
 # node order: the cubic map of the written frame 0 puts points on the ring's cylinder
 m = meshio.read(os.path.join(out, frames[0][1]))

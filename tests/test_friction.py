@@ -45,7 +45,7 @@ hoop       the speed at 0.4 t_r is v0 - mu g 0.4 t_r (1%); the slip speed of the
            end force alone, as before 2026-11-26, made 0.13% in the step that handed the
            contact from one node to the next (the thesis' gamma 1.5 carries -0.5 of a force
            into the next step).
-spin       the same hoop spinning at 20 rad/s set 10 um above the plane, mu 0.3, rho_inf 0.8,
+spin       the same hoop spinning at 20 rad/s set on the plane (its face touching), mu 0.3, rho_inf 0.8,
            0.05 s: it hops from node to node while its contact point slides, so Coulomb's law
            makes the friction impulse on it mu times the normal impulse, |px| = mu (m g t + py)
            (within 0.5%; the normal impulse is below m g t as the hoop is in the air part of
@@ -311,7 +311,7 @@ if h is not None:
 h, _ = go("spin", f"""&run dt = 1.0e-3, t_end = 0.05, gravity = 0.0, {-G}, 0.0, rho_inf = 0.8 /
 &output vtu = .false., plots = .false. /
 &body name = 'ring', mesh = 'file', file = '{ring}', omega = 0.0, 0.0, -20.0, {STEEL}, thickness = {H} /
-&obstacle name = 'floor', shape = 'plane', point = 0.0, {-R - H / 2 - 1e-5}, 0.0, normal = 0.0, 1.0, 0.0,
+&obstacle name = 'floor', shape = 'plane', point = 0.0, {-R - H / 2}, 0.0, normal = 0.0, 1.0, 0.0,
   friction = {MU} /
 """)
 if h is not None:

@@ -19,13 +19,15 @@ contains
   !> itself: nearest sub-triangle again) and, with detect, add the penetrating nodes that are
   !> not yet active. Holding the point in late Newton iterations avoids flip-flopping between
   !> two elements at a kink of the C0 surface. Returns the number of constraints added.
-  subroutine contact_update(c, model, q, detect, added, reproject)
+  !> touching: detect the nodes within the tolerance too (gap <= tol, not only < -tol): the
+  !> start's contacts (contact_touching)
+  subroutine contact_update(c, model, q, detect, added, reproject, touching)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     logical, intent(in) :: detect
     integer, intent(out) :: added
-    logical, intent(in), optional :: reproject
+    logical, intent(in), optional :: reproject, touching
     real(dp), allocatable :: x(:, :), q_start(:)
     real(dp) :: boxi(3, 2), boxt(3, 2), r, reach, nrm(3), d, gs
     integer :: ip, bi, bt, n, k
@@ -103,13 +105,18 @@ contains
     !> add cn if its gap is beyond the tolerance (sticking, with friction)
     subroutine take(cn)
       type(constraint_t), intent(inout) :: cn
+      real(dp) :: below
       if (friction_on(c, cn%pair)) cn%grip = stick
       call constraint_geometry(c, model, x, q, cn, normals)
       if (c%opt%stick_at_touch .and. cn%grip == stick) then   ! (its slip so far is not stuck)
         cn%u0 = cn%ut
         call constraint_geometry(c, model, x, q, cn, normals)
       end if
-      if (cn%gap < -c%opt%tol) then
+      below = -c%opt%tol
+      if (present(touching)) then
+        if (touching) below = c%opt%tol
+      end if
+      if (cn%gap < below) then
         gs = start_gap(cn)
         ! already between the target's faces at the step's start, not held, come in edge-on
         ! (through the rim, past the faces) or sideways: casca has no edge contact, and

@@ -384,7 +384,7 @@ contains
     if (bt > 0) then
       search_radius = face_reach(c, model, bi, bt) + c%geo%depth(bt)
     else
-      search_radius = face_reach(c, model, bi, bt) + c%opt%tol
+      search_radius = face_reach(c, model, bi, bt) + max(c%opt%tol, 0._dp)   ! (a probe's -huge: any gap)
     end if
   end function search_radius
 end module casca_contact

@@ -33,7 +33,7 @@ module casca_run
   use casca_contact_friction, only: pair_tangential_force
   use casca_checkpoint, only: save_checkpoint, load_checkpoint
   use casca_plots, only: make_plots
-  use casca_pair_gaps, only: pair_gap_t, pair_gaps, pair_gap_lines
+  use casca_pair_gaps, only: pair_gap_t, pair_gaps, pair_gaps_at, pair_gap_lines
   use casca_files, only: folder_of
   use casca_stop_request, only: catch_stop_signals, stop_requested, signal_name
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
@@ -125,7 +125,6 @@ contains
     call read_deck(path, deck)
     if (deck%nproblems == deck%readable_problems) call check_deck(deck)   ! (the others' values too)
     if (deck%nproblems == 0) call build_model(deck, model)
-    if (deck%nproblems == 0) call check_thickness()
     if (deck%nproblems == 0) call check_overlap()
     if (present(gaps)) then
       if (gaps .and. deck%nproblems == 0) call gap_report()
@@ -141,22 +140,6 @@ contains
       code = exit_input
     end if
   contains
-    !> a thickness above half its body's size is no shell: a length in another unit (2 for
-    !> 0.002 on a ball of 0.05 m weighed 66 t and ran)
-    subroutine check_thickness()
-      real(dp) :: extent
-      integer :: b
-      do b = 1, model%nbody
-        associate (bd => model%body(b))
-          extent = maxval(maxval(model%x0(:, bd%node_first:bd%node_last), dim=2) - &
-                          minval(model%x0(:, bd%node_first:bd%node_last), dim=2))
-          if (bd%thickness > 0.5_dp*extent) call add_problem(deck, deck%bodies(b)%line, '&body '//bd%name// &
-            ': thickness '//rtoa(bd%thickness)//' m is more than half the body''s size, '//rtoa(extent)// &
-            ' m: no shell is that thick (a length in another unit?)')
-        end associate
-      end do
-    end subroutine check_thickness
-
     !> bodies of a contact pair that overlap at the start are refused, never ignored: named at
     !> the impactor body's line, or at the obstacle's (a container's body outside it)
     subroutine check_overlap()
@@ -829,16 +812,19 @@ contains
 
   !> The acceleration at the start: the body's g on every point of a free body clear of
   !> contact under gravity alone, the equation of motion's M^-1 (F - f_int - f_p) on a body
-  !> clear of contact that carries a load (casca_start_acceleration). Bodies near a contact
-  !> start at a = 0: under gravity their contacts carry their weight from the start
-  !> (start_carry). With 0 for a falling body the first step would change its momentum by
-  !> (gamma - 1/2) m g dt too much (thesis Newmark: 3e-5 of a bouncing ring's momentum
-  !> change).
+  !> clear of contact that carries a load (casca_start_acceleration). Bodies that touch a
+  !> contact (a pair's gap within the contact tolerance) start at a = 0: under gravity their
+  !> contacts carry their weight from the start (start_carry). With 0 for a falling body the
+  !> first step would change its momentum by (gamma - 1/2) m g dt too much (thesis Newmark:
+  !> 3e-5 of a bouncing ring's momentum change). Touching, not near: a ring 0.5 mm above a
+  !> floor (h 4 mm, within the contact's search band) fell with its momentum (gamma - 1) m g dt
+  !> off for the whole fall, booked on the floor as an impulse before any contact.
   subroutine start_acceleration(r)
     type(run_t), intent(inout) :: r
     logical, dimension(r%model%nbody) :: falls, held, ground, loaded, moves
     logical, allocatable :: near(:)
-    integer :: b, n
+    type(pair_gap_t), allocatable :: pg(:)
+    integer :: b, n, k
     associate (model => r%model, st => r%st)
       do b = 1, model%nbody
         associate (bd => model%body(b))
@@ -852,7 +838,22 @@ contains
         moves = falls .or. loaded
         allocate (near(r%contact%npairs))
         call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, moves, near)
-        held = falls .and. .not. moves   ! (under gravity, free, but near a contact)
+        if (any(near)) then   ! (the exact gaps only where the bounding boxes are near)
+          pg = pair_gaps_at(r%contact, model, st%q, st%qd, horizon=0._dp)
+          near = near .and. pg%gap <= r%contact%opt%tol
+          moves = falls .or. loaded
+          do k = 1, size(near)
+            if (.not. near(k)) cycle
+            moves(r%contact%pair(1, k)) = .false.
+            if (r%contact%pair(2, k) > 0) moves(r%contact%pair(2, k)) = .false.
+          end do
+          ! the touching nodes are active from the first step: a plate laid on a floor sank
+          ! by up to the tolerance before they were found, and pushed back in one step its
+          ! mid-surface kept the speed (the correction stops the faces, through the fibres'
+          ! light inertia) and it bounced, making energy
+          if (any(near)) call contact_update(r%contact, model, st%q, .true., k, touching=.true.)
+        end if
+        held = falls .and. .not. moves   ! (under gravity, free, touching a contact)
         falls = falls .and. moves
         loaded = loaded .and. moves
         r%held_at_start = any(held)
@@ -1015,8 +1016,7 @@ contains
     character(len=*), intent(in) :: why
     character(len=:), allocatable :: reason
     reason = why   ! (why may be r%err's message, which the frame and checkpoint below reset)
-    if (is_root()) write (0, '(a,es12.5,a,a)') 'error: the solver cannot go on at t = ', r%st%t, &
-      ' s: ', reason
+    if (is_root()) write (0, '(a)') 'error: the solver cannot go on '//when(r)//': '//reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
     if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
     call keep_and_stop(r, reason)
@@ -1046,6 +1046,17 @@ contains
     end function sudden_static_friction
   end subroutine give_up
 
+  !> where a run that stops early is: its time, or in statics its load factor
+  function when(r) result(text)
+    type(run_t), intent(in) :: r
+    character(len=:), allocatable :: text
+    if (r%deck%run%analysis == 'static') then
+      text = 'after load factor '//rtoa(r%st%t)//' of 1'
+    else
+      text = 'at t = '//rtoa(r%st%t)//' s of t_end = '//rtoa(r%deck%run%t_end)//' s'
+    end if
+  end function when
+
   !> A stop signal came (stop_request): the step under way was finished; keep its state as
   !> a frame and checkpoint and stop with exit_signal, so that --restart goes on from here
   subroutine stop_on_request(r, sig)
@@ -1067,10 +1078,11 @@ contains
     call frame(r)
     call checkpoint(r)
     call r%ls%finish()
-    where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5 (restart with --restart)'
+    where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5'
+    ! (a body that nothing holds has no equilibrium to go on to, from any state)
+    if (index(reason, 'no equilibrium') == 0) where_kept = where_kept//' (restart with --restart)'
     if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
-    call output_mark_stopped(r%out, 'this run stopped at t = '//rtoa(r%st%t)//' s of t_end = '// &
-                             rtoa(r%deck%run%t_end)//' s: '//reason//new_line('a')//where_kept)
+    call output_mark_stopped(r%out, 'this run stopped '//when(r)//': '//reason//new_line('a')//where_kept)
     call output_close(r%out, e)
     if (is_root()) write (0, '(a)') where_kept
   end subroutine keep_and_stop

@@ -55,6 +55,10 @@ contains
         if (r%tolerance_length /= unset) call positive(l, '&run: tolerance_length', r%tolerance_length)
       case ('static')
         if (r%load_steps < 1) call add_problem(deck, l, '&run: load_steps must be >= 1')
+        ! (time-stepping keys a static run would ignore: said, not passed over)
+        if (r%tolerance /= unset) call dynamic_only('tolerance')
+        if (r%tolerance_length /= unset) call dynamic_only('tolerance_length')
+        if (r%rho_inf /= unset .and. r%tolerance == unset) call dynamic_only('rho_inf')   ! (else tolerance's default)
       case default
         call add_problem(deck, l, '&run: analysis must be ''dynamic'' or ''static'' (got '''// &
                          trim(r%analysis)//''')')
@@ -345,6 +349,13 @@ contains
       call finite(line, field, v)
       if (.not. (norm2(v) > 0)) call add_problem(deck, line, field//' must be a non-zero vector')
     end subroutine unit_vector
+
+    !> a key of the time steps in a static deck, which steps its load (load_steps)
+    subroutine dynamic_only(key)
+      character(len=*), intent(in) :: key
+      call add_problem(deck, deck%run%line, '&run: '//key//' is for analysis = ''dynamic''; a static &
+        &run steps its load by load_steps (remove '//key//', or set analysis = ''dynamic'')')
+    end subroutine dynamic_only
 
     subroutine positive(line, field, v)
       integer, intent(in) :: line

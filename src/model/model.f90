@@ -5,6 +5,7 @@
 module casca_model
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
+  use casca_strings, only: rtoa
   use casca_mesh, only: mesh_t, nen
   use casca_shape_tri10, only: tri10_shape, tri10_normal, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, shell_mass, &
@@ -169,9 +170,17 @@ contains
                            h, model%binv(:, :, :, e), model%wdet(:, e), detmin)
       if (detmin <= 0) then
         write (msg, '(a,i0,a,a,a)') 'element ', e - model%body(model%elem_body(e))%elem_first + 1, &
-          ' of body "', model%body(model%elem_body(e))%name, &
-          '" is degenerate or inverted (det A0 <= 0 at a quadrature point)'
-        call fatal_error(err, trim(msg)); return
+          ' of body "', model%body(model%elem_body(e))%name, '"'
+        ! (a mid-surface that is sound: the faces cross through the centre of curvature)
+        call shell_reference(model%rule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
+                             1e-6_dp*h, model%binv(:, :, :, e), model%wdet(:, e), detmin)
+        if (detmin > 0) then
+          call fatal_error(err, trim(msg)//' turns inside out through its thickness, '//rtoa(h)// &
+            ' m: its faces pass its centre of curvature there (a length in another unit?)')
+        else
+          call fatal_error(err, trim(msg)//' is degenerate or inverted (det A0 <= 0 at a quadrature point)')
+        end if
+        return
       end if
       call shell_mass(mrule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), h, &
                       model%body(model%elem_body(e))%density, model%emass(:, :, e))

@@ -117,6 +117,7 @@ contains
         cycle
       end if
       call check_orientation(deck, ib, mesh)
+      call check_thickness(deck, ib, mesh)
       if (allocated(mesh%sets)) then
         call move_alloc(mesh%sets, sets(ib)%sets)
       else
@@ -177,6 +178,23 @@ contains
     model%load_stiffness = deck%run%load_stiffness
     call closed_pressures(model)
   end subroutine build_model
+
+  !> a thickness above half its body's size is no shell: a length in another unit (2 for
+  !> 0.002 on a ball of 0.05 m weighed 66 t and ran). Judged on the mesh, before the elements
+  !> are set up: thicker than its radius of curvature, a ring turns inside out through its
+  !> thickness, and was refused as a degenerate element, with no line
+  subroutine check_thickness(deck, ib, mesh)
+    type(deck_t), intent(inout) :: deck
+    integer, intent(in) :: ib
+    type(mesh_t), intent(in) :: mesh
+    real(dp) :: extent
+    associate (b => deck%bodies(ib))
+      extent = maxval(maxval(mesh%x, dim=2) - minval(mesh%x, dim=2))
+      if (b%thickness > 0.5_dp*extent) call add_problem(deck, b%line, '&body '//trim(b%name)// &
+        ': thickness '//rtoa(b%thickness)//' m is more than half the body''s size, '//rtoa(extent)// &
+        ' m: no shell is that thick (a length in another unit?)')
+    end associate
+  end subroutine check_thickness
 
   !> model%pressure_closed: per body, its loaded elements carry one pressure and every edge of
   !> theirs is shared by exactly two of them, traversed both ways (no rim, branch or flip).
