@@ -19,15 +19,15 @@ contains
   !> itself: nearest sub-triangle again) and, with detect, add the penetrating nodes that are
   !> not yet active. Holding the point in late Newton iterations avoids flip-flopping between
   !> two elements at a kink of the C0 surface. Returns the number of constraints added.
-  !> touching: detect the nodes within the tolerance too (gap <= tol, not only < -tol): the
-  !> start's contacts (contact_touching)
+  !> touching (per pair): detect its nodes within the tolerance too (gap <= tol, not only
+  !> < -tol): the contacts a body rests on at the start
   subroutine contact_update(c, model, q, detect, added, reproject, touching)
     type(contact_t), intent(inout) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     logical, intent(in) :: detect
     integer, intent(out) :: added
-    logical, intent(in), optional :: reproject, touching
+    logical, intent(in), optional :: reproject, touching(:)
     real(dp), allocatable :: x(:, :), q_start(:)
     real(dp) :: boxi(3, 2), boxt(3, 2), r, reach, nrm(3), d, gs
     integer :: ip, bi, bt, n, k
@@ -114,7 +114,7 @@ contains
       end if
       below = -c%opt%tol
       if (present(touching)) then
-        if (touching) below = c%opt%tol
+        if (touching(cn%pair)) below = c%opt%tol
       end if
       if (cn%gap < below) then
         gs = start_gap(cn)

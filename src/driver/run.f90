@@ -37,6 +37,7 @@ module casca_run
   use casca_files, only: folder_of
   use casca_stop_request, only: catch_stop_signals, stop_requested, signal_name
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
+  use casca_obstacle, only: obstacle_point
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_strings, only: count_of, rtoa, vtoa, ftoa, itoa
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
@@ -812,18 +813,15 @@ contains
 
   !> The acceleration at the start: the body's g on every point of a free body clear of
   !> contact under gravity alone, the equation of motion's M^-1 (F - f_int - f_p) on a body
-  !> clear of contact that carries a load (casca_start_acceleration). Bodies that touch a
-  !> contact (a pair's gap within the contact tolerance) start at a = 0: under gravity their
-  !> contacts carry their weight from the start (start_carry). With 0 for a falling body the
-  !> first step would change its momentum by (gamma - 1/2) m g dt too much (thesis Newmark:
-  !> 3e-5 of a bouncing ring's momentum change). Touching, not near: a ring 0.5 mm above a
-  !> floor (h 4 mm, within the contact's search band) fell with its momentum (gamma - 1) m g dt
-  !> off for the whole fall, booked on the floor as an impulse before any contact.
+  !> clear of contact that carries a load (casca_start_acceleration). Bodies held by their
+  !> contacts (start_holds) start at a = 0: under gravity their contacts carry their weight
+  !> from the start (start_carry). With 0 for a falling body the first step would change its
+  !> momentum by (gamma - 1/2) m g dt too much (thesis Newmark: 3e-5 of a bouncing ring's
+  !> momentum change).
   subroutine start_acceleration(r)
     type(run_t), intent(inout) :: r
     logical, dimension(r%model%nbody) :: falls, held, ground, loaded, moves
     logical, allocatable :: near(:)
-    type(pair_gap_t), allocatable :: pg(:)
     integer :: b, n, k
     associate (model => r%model, st => r%st)
       do b = 1, model%nbody
@@ -839,19 +837,13 @@ contains
         allocate (near(r%contact%npairs))
         call clear_near_contact(model, st%q, st%qd, r%deck%run%dt, r%contact, moves, near)
         if (any(near)) then   ! (the exact gaps only where the bounding boxes are near)
-          pg = pair_gaps_at(r%contact, model, st%q, st%qd, horizon=0._dp)
-          near = near .and. pg%gap <= r%contact%opt%tol
+          call start_holds(r, ground, loaded, near)
           moves = falls .or. loaded
           do k = 1, size(near)
             if (.not. near(k)) cycle
             moves(r%contact%pair(1, k)) = .false.
             if (r%contact%pair(2, k) > 0) moves(r%contact%pair(2, k)) = .false.
           end do
-          ! the touching nodes are active from the first step: a plate laid on a floor sank
-          ! by up to the tolerance before they were found, and pushed back in one step its
-          ! mid-surface kept the speed (the correction stops the faces, through the fibres'
-          ! light inertia) and it bounced, making energy
-          if (any(near)) call contact_update(r%contact, model, st%q, .true., k, touching=.true.)
         end if
         held = falls .and. .not. moves   ! (under gravity, free, touching a contact)
         falls = falls .and. moves
@@ -873,6 +865,58 @@ contains
       end if
     end associate
   end subroutine start_acceleration
+
+  !> Of the pairs near at the start, those that hold their bodies from the start (near, on
+  !> return). A pair's touching nodes are constraints from the first step where it touches
+  !> (a gap within the contact tolerance: a ring 0.5 mm above a floor, within the search
+  !> band, was held, its momentum (gamma - 1) m g dt off for the fall), is not parting (the
+  !> closest node's closing speed) and, an obstacle, is under the body's weight (it pushes
+  !> along its normal; a body with other loads is left held); found only once they
+  !> penetrated past the tolerance, the nodes of a plate laid on a floor sank, and the step
+  !> that pushed them back left its mid-surface rising (the correction stops the faces,
+  !> largely through the fibres' light inertia): it bounced, making energy. Such a pair
+  !> holds its bodies where it is grounded too, by touching pairs, on an obstacle or a
+  !> restrained body: a plate touching a ceiling, a ring thrown up off a floor and two
+  !> touching rings falling together were held at a = 0, their first step 0.5 M a dt off,
+  !> booked on the pair.
+  subroutine start_holds(r, ground, loaded, near)
+    type(run_t), intent(inout) :: r
+    logical, intent(in) :: ground(:), loaded(:)
+    logical, intent(inout) :: near(:)
+    type(pair_gap_t), allocatable :: pg(:)
+    logical :: grounded(size(ground)), changed
+    real(dp) :: nrm(3), d
+    integer :: k, i, j, added
+    associate (model => r%model, c => r%contact, st => r%st)
+      pg = pair_gaps_at(c, model, st%q, st%qd, horizon=0._dp)
+      near = near .and. pg%gap <= c%opt%tol .and. pg%speed >= 0
+      do k = 1, c%npairs
+        i = c%pair(1, k); j = c%pair(2, k)
+        if (.not. near(k) .or. j > 0 .or. loaded(i)) cycle
+        call obstacle_point(c%obstacle(-j), c%time, st%q(dof(pg(k)%node, 1):dof(pg(k)%node, 3)), nrm, d)
+        near(k) = dot_product(nrm, model%body(i)%gravity) < 0
+      end do
+      grounded = ground
+      changed = .true.
+      do while (changed)
+        changed = .false.
+        do k = 1, c%npairs
+          if (.not. near(k)) cycle
+          i = c%pair(1, k); j = c%pair(2, k)
+          if (j <= 0) then
+            changed = changed .or. .not. grounded(i)
+            grounded(i) = .true.
+          else if (grounded(i) .neqv. grounded(j)) then
+            grounded(i) = .true.; grounded(j) = .true.; changed = .true.
+          end if
+        end do
+      end do
+      if (any(near)) call contact_update(c, model, st%q, .true., added, touching=near)
+      do k = 1, c%npairs   ! (touching, they meet from the first step; held where grounded)
+        if (near(k)) near(k) = grounded(c%pair(1, k))
+      end do
+    end associate
+  end subroutine start_holds
 
   !> (3, nbody): the weight of each body of which, M g on its positions (the consistent mass's
   !> Y-Y entries summed, the momentum's metric), 0 for the others
