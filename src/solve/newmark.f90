@@ -69,7 +69,10 @@ contains
     allocate (a0, source=st%qdd)   ! (explicitly: gcc 12 warned of the descriptor)
     free = .true.
     if (present(contact)) free = contact%set%nact == 0
-    if (free .and. st%h_last > 0) call nm%moved_start(st%h_last, st%qdd_last, a0)
+    if (free .and. st%h_last > 0) then
+      call nm%moved_start(st%h_last, st%qdd_last, a0)
+      if (present(contact)) call nm%moved_share(st%h_last, contact%carry)
+    end if
     allocate (q(size(st%q)), qd(size(st%q)), qdd(size(st%q)))
     if (present(contact)) then
       call contact_force_points(contact, model, nm%alpha_f, st%q)   ! (as the last step left them: restarts too)
