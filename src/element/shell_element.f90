@@ -11,13 +11,14 @@
 module casca_shell_element
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_shape_tri10, only: tri10_shape
+  use casca_shape_tri10, only: tri10_shape, tri10_node_xi
   use casca_quadrature, only: triangle_rule, gauss_rule
   use casca_vectors, only: cross
   implicit none
   private
   public :: shell_rule_t, shell_rule_init, shell_reference, shell_energy_force, shell_mass
-  public :: ndof_node, ndof_elem, svk_lame, shell_stress, von_mises
+  public :: ndof_node, ndof_elem, svk_lame, shell_stress, von_mises, shell_face_stretch, &
+            shell_face_metric
 
   integer, parameter :: ndof_node = 7
   integer, parameter :: ndof_elem = 70
@@ -31,6 +32,7 @@ module casca_shell_element
     real(dp), allocatable :: dphi(:, :, :)  !< (10, 2, na)
     real(dp), allocatable :: wa(:)          !< (na)
     real(dp), allocatable :: z(:), wz(:)    !< (nt)
+    real(dp) :: dphi_node(10, 2, 10) = 0    !< dphi at the 10 nodes (shell_face_stretch)
   end type shell_rule_t
 
 contains
@@ -48,6 +50,7 @@ contains
     type(shell_rule_t), intent(out) :: rule
     type(error_t), allocatable, intent(out) :: err
     real(dp), allocatable :: xi(:, :)
+    real(dp) :: phi(10)
     integer :: ia
 
     call triangle_rule(na, xi, rule%wa, err)
@@ -58,6 +61,9 @@ contains
     allocate (rule%phi(10, na), rule%dphi(10, 2, na))
     do ia = 1, na
       call tri10_shape(xi(1, ia), xi(2, ia), rule%phi(:, ia), rule%dphi(:, :, ia))
+    end do
+    do ia = 1, 10
+      call tri10_shape(tri10_node_xi(1, ia), tri10_node_xi(2, ia), phi, rule%dphi_node(:, :, ia))
     end do
   end subroutine shell_rule_init
 
@@ -316,6 +322,58 @@ contains
     end do
     sig = matmul(f, matmul(s, transpose(f)))/det3(f)
   end function shell_stress
+
+  !> The faces' metrics at the element's nodes before it moves: m0(:, k, l) = the dot products
+  !> [a1.a1, a1.a2, a2.a2] of the in-plane columns of A0 on face k (xi3 = -1, +1) at node l
+  pure subroutine shell_face_metric(rule, x0, v0, h, m0)
+    type(shell_rule_t), intent(in) :: rule
+    real(dp), intent(in) :: x0(3, 10), v0(3, 10), h
+    real(dp), intent(out) :: m0(3, 2, 10)
+    real(dp) :: a(3, 2)
+    integer :: l, k
+    do l = 1, 10
+      do k = 1, 2
+        a = matmul(x0 + (h*(k - 1.5_dp))*v0, rule%dphi_node(:, :, l))
+        m0(:, k, l) = [dot_product(a(:, 1), a(:, 1)), dot_product(a(:, 1), a(:, 2)), &
+                       dot_product(a(:, 2), a(:, 2))]
+      end do
+    end do
+  end subroutine shell_face_metric
+
+  !> The least stretch along the faces at the element's nodes, and the node (1..10): the smaller
+  !> root of det(M1 - s^2 M0) = 0, M0 and M1 the face's metric before (shell_face_metric) and
+  !> now. A fold bent to a radius near the thickness squeezes its inner face along itself as a
+  !> squeeze through the thickness does the fibre. At a node the shape functions are 1 there
+  !> and 0 at the others, so G and A are the node's own: dy/dxi_j = Y,j + s G,j + s_j G with
+  !> s = h/2 (z + A), s_j = h/2 A,j on the face z = +-1 (current_jacobian).
+  pure subroutine shell_face_stretch(rule, m0, h, q, stretch, node)
+    type(shell_rule_t), intent(in) :: rule
+    real(dp), intent(in) :: m0(3, 2, 10), h, q(7, 10)
+    real(dp), intent(out) :: stretch
+    integer, intent(out) :: node
+    real(dp) :: d(7, 20), a(3, 2), m1(3), b, c, s2
+    integer :: l, k
+    stretch = huge(1._dp); node = 1
+    d = matmul(q, reshape(rule%dphi_node, [10, 20]))   ! Y,j G,j A,j at node l: d(:, 2l-1 : 2l)
+    do l = 1, 10
+      do k = 1, 2
+        a = d(1:3, 2*l - 1:2*l) + (0.5_dp*h*(2*k - 3 + q(7, l)))*d(4:6, 2*l - 1:2*l)
+        a(:, 1) = a(:, 1) + (0.5_dp*h*d(7, 2*l - 1))*q(4:6, l)
+        a(:, 2) = a(:, 2) + (0.5_dp*h*d(7, 2*l))*q(4:6, l)
+        m1 = [dot_product(a(:, 1), a(:, 1)), dot_product(a(:, 1), a(:, 2)), dot_product(a(:, 2), a(:, 2))]
+        associate (n => m0(:, k, l))
+          b = n(1)*m1(3) + n(3)*m1(1) - 2*n(2)*m1(2)
+          c = n(1)*n(3) - n(2)**2
+          s2 = huge(1._dp)   ! (a face through its centre of curvature has no metric: refused)
+          if (c > 0) s2 = (b - sqrt(max(b*b - 4*c*(m1(1)*m1(3) - m1(2)**2), 0._dp)))/(2*c)
+        end associate
+        if (s2 < stretch) then
+          stretch = s2; node = l
+        end if
+      end do
+    end do
+    stretch = sqrt(max(stretch, 0._dp))
+  end subroutine shell_face_stretch
 
   !> A1 = dy/dxi at a point of the current configuration (the map of the module header):
   !> dy/dxi_j = Y,j + s G,j + s_j G and dy/dxi3 = (h/2 + a h z) G, s = h/2 (z + a z^2),

@@ -9,11 +9,12 @@ module casca_model
   use casca_mesh, only: mesh_t, nen
   use casca_shape_tri10, only: tri10_shape, tri10_normal, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, shell_mass, &
-                                 svk_lame, ndof_node
+                                 svk_lame, ndof_node, shell_face_stretch, &
+                                 shell_face_metric
   implicit none
   private
   public :: body_t, model_t, model_add_body, model_finalize, dof, element_dofs, reference_state
-  public :: area_points, thick_points, element_area, thinnest
+  public :: area_points, thick_points, element_area, thinnest, least_face_stretch
 
   integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
   integer, parameter :: thick_points = 3
@@ -37,6 +38,7 @@ module casca_model
     integer, allocatable :: elem_body(:), node_body(:)
     type(shell_rule_t) :: rule               !< stiffness rule
     real(dp), allocatable :: binv(:, :, :, :), wdet(:, :)   !< (3,3,np,nelem), (np,nelem)
+    real(dp), allocatable :: face_metric(:, :, :, :)        !< (3,2,10,nelem) shell_face_metric
     real(dp), allocatable :: emass(:, :, :)  !< (20, 20, nelem) scalar element mass
     logical, allocatable :: fixed(:)         !< (ndof) prescribed parameters
     real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
@@ -72,6 +74,27 @@ contains
       end if
     end do
   end subroutine thinnest
+
+  !> The node whose face is stretched least along itself (shell_face_stretch) and that stretch
+  pure subroutine least_face_stretch(model, q, node, stretch)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    integer, intent(out) :: node
+    real(dp), intent(out) :: stretch
+    real(dp) :: qe(ndof_node, nen), s
+    integer :: e, l, n
+    node = 0; stretch = huge(1._dp)
+    do e = 1, model%nelem
+      do l = 1, nen
+        qe(:, l) = q(dof(model%conn(l, e), 1):dof(model%conn(l, e), ndof_node))
+      end do
+      call shell_face_stretch(model%rule, model%face_metric(:, :, :, e), &
+                              model%body(model%elem_body(e))%thickness, qe, s, n)
+      if (s < stretch) then
+        stretch = s; node = model%conn(n, e)
+      end if
+    end do
+  end subroutine least_face_stretch
 
   !> The 70 dofs of element e in the element order 7(l-1)+c.
   pure function element_dofs(model, e) result(d)
@@ -163,9 +186,11 @@ contains
     end do
 
     allocate (model%binv(3, 3, model%rule%np, model%nelem), model%wdet(model%rule%np, model%nelem))
-    allocate (model%emass(20, 20, model%nelem))
+    allocate (model%emass(20, 20, model%nelem), model%face_metric(3, 2, nen, model%nelem))
     do e = 1, model%nelem
       h = model%body(model%elem_body(e))%thickness
+      call shell_face_metric(model%rule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
+                             h, model%face_metric(:, :, :, e))
       call shell_reference(model%rule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
                            h, model%binv(:, :, :, e), model%wdet(:, e), detmin)
       if (detmin <= 0) then
