@@ -22,8 +22,15 @@ obstacles      a ring (R 0.2, h 0.04) at (1, -2, 0) m/s above a floor plane 0.3 
                are at z = +-w/6, +-w/2, so its nearest node is at D = sqrt(0.3^2 + (w/6)^2) from
                the centre, off the vertical by c = 0.3 / D: gap D - 0.2 - (h/2) c (the face along
                the radial fibre, projected on the line to the centre, as a constraint measures
-               it), closing speed 3 c m/s, time gap / (3 c); the same sphere at rest: 'never'
-               (the ring moves away from it).
+               it), closing speed 3 c m/s; time: the earliest at which a node, moving straight on
+               at (1, 3, 0) m/s relative to the sphere, has its face ((h/2) |fibre . n|, the fibre
+               radial, n the sphere's normal there) on the sphere, by the test's own bisection
+               along each node's path (not the gap over the closing speed, which is exact for a
+               plane only); the same sphere at rest: 'never' (the ring moves away from it).
+inside sphere  a ball (R 0.05, h 2 mm) 0.1 m off the centre of a spherical container (radius 0.2)
+               at (2, 3, 1) m/s: gap 0.2 - 0.15 - h/2; time by the same bisection to the inner
+               wall (casca before 2026-11-29 printed its nearest node's gap over its closing
+               speed: 21.3 ms for 18.6).
 self-contact   the ring's pair with itself: time to contact 'never' (its rigid motion closes no gap).
 rim edge-on    a plate (h_a 20 mm, 1 m square, 2 x 2 cells) in z = 0 and a finer plate (h_b 10 mm,
                0.4 x 0.5 m, 4 x 4 cells, the impactor) standing in x = 1.1, its mid row of nodes
@@ -130,9 +137,41 @@ run([casca, "mesh", "ring", "--radius", "0.2", "--width", "0.05", "--n-around", 
 r, hr = 0.2, 0.04
 
 
+def face_time(mesh, fibre, w, centre, radius, half, inside):
+    """The earliest time at which a node of the mesh, moving straight on at w relative to a
+    rigid sphere, has its face, half x |fibre . n| off its mid-surface along the sphere's normal
+    n there, on the sphere (inside: on its inner wall); bisection on each node's path"""
+    import meshio
+    import numpy as np
+    x = meshio.read(mesh).points
+    w, c = np.array(w), np.array(centre)
+
+    def excess(p, f):   # > 0: clear of the wall
+        d = np.linalg.norm(p - c)
+        off = half * abs(np.dot(f, (p - c) / d))
+        return (radius - off - d) if inside else (d - radius - off)
+
+    best = math.inf
+    for xn in x:
+        f = fibre(xn)
+        f = f / np.linalg.norm(f)
+        ts = np.linspace(0.0, 1.0, 2001)
+        ex = [excess(xn + w * t, f) for t in ts]
+        k = next((i for i in range(len(ts) - 1) if ex[i] > 0 >= ex[i + 1]), None)
+        if k is None:
+            continue
+        a, b = ts[k], ts[k + 1]
+        for _ in range(60):
+            m = (a + b) / 2
+            a, b = (m, b) if excess(xn + w * m, f) > 0 else (a, m)
+        best = min(best, b)
+    return best
+
+
 def ring_obstacles(ball_v):
     return f"""&run dt = 2.0e-5, t_end = 1.0e-3 /
-&body name = 'ring', mesh = 'file', file = '{small}', velocity = 1.0, -2.0, 0.0, {STEEL}, thickness = {hr} /
+&body name = 'ring', mesh = 'ring', radius = 0.2, width = 0.05, n_around = 20, n_across = 1,
+  velocity = 1.0, -2.0, 0.0, {STEEL}, thickness = {hr} /
 &obstacle name = 'floor', shape = 'plane', point = 0.0, -0.3, 0.0, normal = 0.0, 1.0, 0.0 /
 &obstacle name = 'ball', shape = 'sphere', point = 0.0, 0.5, 0.0, radius = 0.2, velocity = 0.0, {ball_v}, 0.0 /
 &contact pairs = 'ring', 'ring' /
@@ -148,12 +187,24 @@ D = math.hypot(0.5 - r, 0.05 / 6)
 c = (0.5 - r) / D
 close("falling sphere: gap [m]", ball[0], D - 0.2 - hr / 2 * c)
 close("falling sphere: closing speed [m/s]", ball[1], 3.0 * c)
-close("falling sphere: time to contact [s]", ball[2], (D - 0.2 - hr / 2 * c) / (3.0 * c))
+close("falling sphere: time to contact [s]", ball[2],
+      face_time(small, lambda x: x * [1, 1, 0], [1.0, 3.0, 0.0], [0.0, 0.5, 0.0], 0.2, hr / 2, False))
 ck.record("self-contact: printed, time to contact 'never'", ("ring", "ring") in got and own[2] is None, str(own))
 got = check("sphere_at_rest", ring_obstacles(0.0))
 ball = got.get(("ring", "ball"), (None,) * 3)
 ck.record("sphere at rest above a ring moving down: 'never'", ("ring", "ball") in got and ball[2] is None
           and ball[1] is not None and ball[1] < 0, str(ball))
+ball_mesh = os.path.join(work, "ball_r005.msh")
+run([casca, "mesh", "sphere", "--radius", "0.05", "--n-div", "2", "-o", ball_mesh])
+got = check("inside_sphere", f"""&run dt = 1.0e-5, t_end = 1.0e-3 /
+&body name = 'ball', mesh = 'sphere', radius = 0.05, n_div = 2, center = 0.1, 0.0, 0.0, velocity = 2.0, 3.0, 1.0,
+  {STEEL}, thickness = 0.002 /
+&obstacle name = 'shell', shape = 'sphere', point = 0.0, 0.0, 0.0, radius = 0.2, inside = .true. /
+""")
+inner = got.get(("ball", "shell"), (None,) * 3)
+close("ball inside a spherical shell: gap [m]", inner[0], 0.2 - 0.15 - 0.001)
+close("ball inside a spherical shell: time to contact [s]", inner[2],
+      face_time(ball_mesh, lambda x: x, [2.0, 3.0, 1.0], [-0.1, 0.0, 0.0], 0.2, 0.001, True))
 for passes, gap in ((1, 0.1 - 0.005 - 0.01), (2, 0.1 - 0.005 - 0.01 * 3 / 16)):
     got = check("rim_edge_on_%d" % passes, f"""&run dt = 1e-5, t_end = 1e-3 /
 &body name = 'a', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 2, ny = 2, {STEEL}, thickness = 0.02 /

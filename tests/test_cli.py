@@ -27,6 +27,9 @@ Asserted about the command line itself (issue 17):
   'x', 'y') with how to write it.
 - a run whose solver cannot go on exits 3 and leaves stopped.txt in its folder, with the
   stop time it printed and the deck's t_end; a finished run into the folder removes it.
+- a `&restraint` or `&load` given a box and a node list exits 2 at its line (each selects on
+  its own; the box was dropped); a run into a folder that holds another run's 7 frames
+  leaves its own 2 there, exactly those its run.pvd lists.
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -226,6 +229,11 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["&restraint", "no node", "ring2"]),
     ("node set out of range", lambda s: s + "&restraint\n body = 'ring2', nodes = 1, 2, 999, fix = 'y'\n/\n",
      ["&restraint", "nodes(3) = 999", "out of range 1..240"]),
+    # (each selects on its own: given a box and a list, the box was dropped without a word)
+    ("a restraint given a box and nodes", lambda s: s + "&restraint\n body = 'ring2', box_max = 1e9, 0.0, 1e9, "
+     "nodes = 1, 2, fix = 'y'\n/\n", ["&restraint: give one of set, nodes or box_min/box_max", ":%d:" % (good.count("\n") + 1)]),
+    ("a load given a box and nodes", lambda s: s + "&load\n body = 'ring2', box_min = 2.0, -1e9, -1e9, nodes = 1, "
+     "force = 0.0, 1.0, 0.0\n/\n", ["&load: give one of set, nodes or box_min/box_max", ":%d:" % (good.count("\n") + 1)]),
     ("unknown body in a restraint", lambda s: s + "&restraint\n body = 'ring9', fix = 'y'\n/\n", ["ring9", "not a body"]),
     ("misspelt body in a restraint", lambda s: s + "&restraint\n body = 'rign2', fix = 'y'\n/\n",
      ["rign2", "not a body", "did you mean 'ring2'?"]),
@@ -335,6 +343,17 @@ if p.returncode == 0:
           np.abs(np.asarray(m.point_data["signed_distance"]).ravel() - 1e-3).max(), 1e-12)
 else:
     ck.record("a plate 1 mm above a plane runs (exit 0)", False, p.stderr[-300:])
+
+# a run into a folder that holds a longer run's frames: only its own stay (before 2026-11-29
+# frames 2..6 of the other run stayed beside its 2, and ParaView's frame_* series mixed them)
+stale = os.path.join(work, "stale_out")
+shutil.rmtree(stale, ignore_errors=True)
+shutil.copytree(out, stale)
+p = run([casca, "run", gap_deck, "--out", stale])
+left = sorted(f for f in os.listdir(stale) if f.startswith("frame_"))
+listed = sorted(os.path.basename(d.get("file")) for d in ET.parse(os.path.join(stale, "run.pvd")).getroot().iter("DataSet"))
+ck.record("a run into a folder with another run's 7 frames leaves only its own 2, those run.pvd lists",
+          p.returncode == 0 and left == listed == ["frame_00000.vtu", "frame_00001.vtu"], "%s, %s" % (left, listed))
 
 # node order: the cubic map of the written frame 0 puts points on the ring's cylinder
 m = meshio.read(os.path.join(out, frames[0][1]))

@@ -6,7 +6,7 @@ module casca_obstacle
   use casca_kinds, only: dp
   implicit none
   private
-  public :: obstacle_t, obstacle_point
+  public :: obstacle_t, obstacle_point, obstacle_ray_time
 
   type :: obstacle_t
     character(len=64) :: name = ''
@@ -50,6 +50,43 @@ contains
       n = -n; d = -d
     end if
   end subroutine obstacle_point
+
+  !> The first time t >= 0 at which a point at x moving at w relative to the obstacle comes
+  !> within off of its surface (0 if it is within already); -1 if it never does. Exact for
+  !> each shape: a path aimed past a sphere's centre meets its wall later than its distance
+  !> over the closing speed says (a ball inside a spherical shell: 21.3 ms for 18.6).
+  pure real(dp) function obstacle_ray_time(ob, x, w, off) result(t)
+    type(obstacle_t), intent(in) :: ob
+    real(dp), intent(in) :: x(3), w(3), off
+    real(dp) :: r(3), u(3), rho, a, b, disc, d, n(3)
+    t = -1
+    if (ob%shape == 'plane') then
+      call obstacle_point(ob, 0._dp, x, n, d)
+      if (d <= off) then
+        t = 0
+      else if (dot_product(w, n) < 0) then
+        t = (d - off)/(-dot_product(w, n))
+      end if
+      return
+    end if
+    r = x - ob%point; u = w
+    if (ob%shape == 'cylinder') then   ! (across the axis)
+      r = r - dot_product(r, ob%normal)*ob%normal; u = u - dot_product(u, ob%normal)*ob%normal
+    end if
+    rho = ob%radius + merge(-off, off, ob%inside)   ! |r + u t| = rho at the face
+    if (merge(dot_product(r, r) >= rho**2, dot_product(r, r) <= rho**2, ob%inside)) then
+      t = 0; return
+    end if
+    a = dot_product(u, u); b = dot_product(r, u)
+    if (a <= 0) return
+    disc = b*b - a*(dot_product(r, r) - rho**2)
+    if (disc < 0) return   ! (outside, passing by)
+    if (ob%inside) then
+      t = (-b + sqrt(disc))/a   ! (leaving the inner ball)
+    else if (b < 0) then
+      t = (-b - sqrt(disc))/a
+    end if
+  end function obstacle_ray_time
 
   pure function unit_across(a) result(u)
     real(dp), intent(in) :: a(3)

@@ -21,13 +21,14 @@
 !> meet a face there. No deformation, no gravity. Not the
 !> closest node's gap over its speed alone: a ring inside a ring is nearest on the side it
 !> moves away from (it said 'never'), and off the axis met the concave wall 19% late. An
-!> obstacle's by each node's gap over its closing speed (exact for a plane). 'never' when no
+!> obstacle's by each node's straight path to its face (obstacle_ray_time; a plane's is the
+!> gap over the closing speed, a curved wall's is not). 'never' when no
 !> node meets it; a body's own surface (self-contact) is never closed by its rigid motion.
 !> The speed printed is the closest node's.
 module casca_pair_gaps
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
-  use casca_obstacle, only: obstacle_point
+  use casca_obstacle, only: obstacle_point, obstacle_ray_time
   use casca_closest_point, only: closest_point_triangle
   use casca_contact, only: contact_t, tested_both_ways
   use casca_contact_projection, only: face, positions, on_rim
@@ -77,7 +78,20 @@ contains
               call obstacle_point(ob, 0._dp, x(:, n), nrm, d)
               gap = d - face_along(c, model, bi, g(:, n), nrm)
               speed = -dot_product(v(:, n) - ob%velocity, nrm)
-              call note(r, n, gap, speed, closing_time(gap, speed, vmax))
+              tn = closing_time(gap, speed, vmax)
+              if (ob%shape /= 'plane' .and. gap > 0) then   ! (a curved wall: along the path)
+                tn = -1
+                u = v(:, n) - ob%velocity
+                if (norm2(u) > 1e-12_dp*vmax) tn = obstacle_ray_time(ob, x(:, n), u, d - gap)
+                do k = 1, 20   ! (the face's offset along the normal where it meets the wall)
+                  if (tn <= 0) exit
+                  tl = tn
+                  call obstacle_point(ob, 0._dp, x(:, n) + tn*u, nrm, d)
+                  tn = obstacle_ray_time(ob, x(:, n), u, face_along(c, model, bi, g(:, n), nrm))
+                  if (abs(tn - tl) <= 1e-13_dp*tl) exit
+                end do
+              end if
+              call note(r, n, gap, speed, tn)
             end do
           end associate
         else

@@ -1071,6 +1071,7 @@ contains
     if (is_root()) write (0, '(a)') 'error: the solver cannot go on '//when(r)//': '//reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
     if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
+    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_coulomb(r)
     call watch_thickness(r, faces=.true.)   ! (the last good state)
     call keep_and_stop(r, reason)
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
@@ -1133,7 +1134,11 @@ contains
     call r%ls%finish()
     where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5'
     ! (a body that nothing holds has no equilibrium to go on to, from any state)
-    if (index(reason, 'no equilibrium') == 0) where_kept = where_kept//' (restart with --restart)'
+    if (index(reason, 'no equilibrium') == 0) then   ! (without --out a restart goes to the deck's folder)
+      where_kept = where_kept//' (restart: casca run '//r%deck%path//' --restart '//r%dir//'/checkpoint.h5'
+      if (r%dir /= trim(r%deck%output%dir)) where_kept = where_kept//' --out '//r%dir
+      where_kept = where_kept//')'
+    end if
     if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
     call output_mark_stopped(r%out, 'this run stopped '//when(r)//': '//reason//new_line('a')//where_kept)
     call output_close(r%out, e)
@@ -1163,6 +1168,7 @@ contains
         '/plots.gp was written but not run'
     end if
     if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
+    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_coulomb(r)
     if (is_root() .and. squeezed(r)) write (0, '(a)') 'warning: '//squeeze_note(r)
     if (.not. is_root() .or. r%quiet) return
     associate (deck => r%deck, model => r%model)
@@ -1304,6 +1310,40 @@ contains
     type(run_t), intent(in) :: r
     step_judged = r%st%step > merge(1, 0, r%held_at_start)
   end function step_judged
+
+  !> Coulomb's bound over the run, where it can be read from the impulse column: a pair with a
+  !> plane obstacle (one normal) takes at most mu times its normal impulse along the plane. The
+  !> trapezoidal rule's contact forces ring, and the friction of a hoop hopping on a floor came
+  !> to 0.56 of its normal impulse at mu 0.3 (the acceleration's projection moves the normal
+  !> share of the step's start, not the friction's: docs/performance.md)
+  subroutine warn_coulomb(r)
+    type(run_t), intent(in) :: r
+    real(dp) :: jn, jt, mu
+    integer :: p
+    if (.not. allocated(r%contact)) return
+    associate (c => r%contact)
+      do p = 1, c%npairs
+        if (c%pair(2, p) >= 0) cycle
+        if (c%obstacle(-c%pair(2, p))%shape /= 'plane') cycle
+        mu = max(c%mu_d(p), c%mu_s(p))
+        if (mu <= 0) cycle
+        jn = dot_product(c%impulse(:, p), c%obstacle(-c%pair(2, p))%normal)
+        jt = norm2(c%impulse(:, p) - jn*c%obstacle(-c%pair(2, p))%normal)
+        if (jn <= 0 .or. jt <= 1.02_dp*mu*jn) cycle
+        write (0, '(a)') 'warning: pair '''//trim(r%model%body(c%pair(1, p))%name)//''' -> '''// &
+          trim(c%obstacle(-c%pair(2, p))%name)//''': its friction impulse is '//ftoa(jt/jn)// &
+          ' of its normal impulse, above its coefficient '//ftoa(mu)//' (Coulomb''s bound): '// &
+          'the contact forces rang from step to step'//trim(ringing())
+      end do
+    end associate
+  contains
+    function ringing() result(s)
+      character(len=:), allocatable :: s
+      s = '; a shorter dt brings it nearer'
+      if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) s = ' ('//r%nm%describe()//' keeps them '// &
+        'undamped: rho_inf = 0.8 (generalized-alpha) damps them)'
+    end function ringing
+  end subroutine warn_coulomb
 
   !> A run from t = 0 whose step made more than 1e-3 of E0 says so: with contact active most
   !> often the contact's doing; with none, the time scheme's, over a motion its steps do not

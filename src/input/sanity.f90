@@ -291,21 +291,22 @@ contains
       end do
     end subroutine check_obstacle
 
-    !> coefficients of friction: >= 0, below 10, the static one (when given) not below the
-    !> dynamic one
-    !> A set needs its body and is the whole selection (neither a node list nor a box with it).
+    !> A selection is one of a set (a physical group of its body's mesh), a node list or a box:
+    !> given two, one would be dropped without a word
     subroutine check_selection(line, group, body, set, nlist, lo, hi)
       integer, intent(in) :: line, nlist
       character(len=*), intent(in) :: group, body, set
       real(dp), intent(in) :: lo(3), hi(3)
-      if (set == '') return
-      if (body == '') call add_problem(deck, line, group//': set needs body = ... (a set is '// &
-                                       'a physical group of a body''s mesh file)')
-      if (nlist > 0) call add_problem(deck, line, group//': give set or nodes, not both')
-      if (any(lo /= -huge(1._dp)) .or. any(hi /= huge(1._dp))) call add_problem(deck, line, &
-        group//': give set or box_min/box_max, not both')
+      logical :: box
+      box = any(lo /= -huge(1._dp)) .or. any(hi /= huge(1._dp))
+      if (set /= '' .and. body == '') call add_problem(deck, line, group//': set needs body = ... (a '// &
+                                                       'set is a physical group of a body''s mesh file)')
+      if (count([set /= '', nlist > 0, box]) > 1) call add_problem(deck, line, group// &
+        ': give one of set, nodes or box_min/box_max (each selects the nodes on its own)')
     end subroutine check_selection
 
+    !> coefficients of friction: >= 0, below 10, the static one (when given) not below the
+    !> dynamic one
     subroutine check_friction(line, group, dyn, sta)
       integer, intent(in) :: line
       character(len=*), intent(in) :: group

@@ -177,8 +177,22 @@ contains
       call keep_history(out, cols, restart_step, earlier, err)
       if (allocated(err)) return
       if (own) call keep_frames(restart_time, err)
+      if (allocated(err)) return
     end if
+    call drop_frames()
   contains
+    !> An earlier run's frames past those this run keeps, and its run.pvd when it keeps none:
+    !> left there, ParaView's frame_* series would mix the two runs (numbered on from 0)
+    subroutine drop_frames()
+      integer :: k
+      if (out%nframes == 0) call delete_file(out%dir//'/run.pvd')
+      k = out%nframes
+      do while (file_kind(out%dir//'/'//frame_name(k)) /= kind_missing)
+        call delete_file(out%dir//'/'//frame_name(k))
+        k = k + 1
+      end do
+    end subroutine drop_frames
+
     !> the frames of the earlier run.pvd with time <= tmax
     subroutine keep_frames(tmax, e)
       real(dp), intent(in) :: tmax
@@ -356,6 +370,13 @@ contains
     if (.not. allocated(err)) call h5_table_flush(out%h5, err)
   end subroutine output_flush
 
+  !> The file of frame k (from 0)
+  pure function frame_name(k) result(name)
+    integer, intent(in) :: k
+    character(len=15) :: name
+    write (name, '(a,i5.5,a)') 'frame_', k, '.vtu'
+  end function frame_name
+
   !> A VTU frame of the state and its entry in run.pvd. extra: more point fields (contact).
   subroutine output_frame(out, model, st, extra, err)
     type(output_t), intent(inout) :: out
@@ -388,7 +409,7 @@ contains
     call stress_fields(model, st%q, cell_stress, point_stress)
     call mesh_indicator(model, st%q, out%ind)
     out%ind_step = st%step
-    write (name, '(a,i5.5,a)') 'frame_', out%nframes, '.vtu'
+    name = frame_name(out%nframes)
     ! geometry in the current configuration: ParaView shows the deformed shells directly
     call write_vtu(out%dir//'/'//trim(name), x, model%conn, &
                    [field('displacement', u), field('velocity', v), field('fibre', g), &
