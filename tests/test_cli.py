@@ -247,6 +247,9 @@ cases = [  # (name, text transformation, substrings the message must hold)
       "density is missing", "4 problems in the deck"]),
     ("a key of another group", lambda s: s.replace("young = 210e9, ", "young = 210e9, pressure = 1e3, ", 1),
      ["&body", "unknown key 'pressure'", "(a key of &load)"]),
+    ("a plane given inside", lambda s: s + "&obstacle\n name = 'floor', shape = 'plane', point = 0.0, -2.0, 0.0, "
+     "normal = 0.0, 1.0, 0.0, inside = .true.\n/\n",
+     ["&obstacle: inside is for a sphere or a cylinder", ":%d:" % (good.count("\n") + 2)]),   # (inside's line)
     ("bad fix", lambda s: s + "&restraint\n body = 'ring2', fix = 'sideways'\n/\n", ["fix", "sideways"]),
     ("fix given as a list", lambda s: s + "&restraint\n body = 'ring2', fix = 'x', 'y'\n/\n",
      ["&restraint", "fix takes one string, 2 given: its components in one, fix = 'x y z'", ":19:"]),
@@ -459,4 +462,18 @@ ck.record("solver failure: stopped.txt names the stop time and t_end", t_stop is
 p = run([casca, "run", deck, "--out", out_s, "-q"])
 ck.record("a finished run into that folder removes stopped.txt", p.returncode == 0 and not os.path.exists(mark),
           p.stderr[-200:])
+# the frame of a run that stops measures the last good state against the obstacles where they
+# were then: a plate lying on a plane rising at 1 m/s, whose first step fails, shows 0 (before
+# 2026-11-29 the obstacle stood where the failed step had put it: -v dt at the nodes)
+stop_deck = os.path.join(work, "gap_stop.nml")
+with open(stop_deck, "w") as f:
+    f.write(open(gap_deck).read().replace("t_end = 1e-4 /", "t_end = 1e-3, newton_max_iter = 1, newton_tol = 1e-30, "
+                                          "max_step_cuts = 1 /").replace("normal = 0.0, 0.0, 1.0 /",
+                                                                         "normal = 0.0, 0.0, 1.0, velocity = 0.0, 0.0, 1.0 /")
+            .replace("center = 0.0, 0.0, 0.006", "center = 0.0, 0.0, 0.005"))
+p = run([casca, "run", stop_deck, "--out", os.path.join(work, "gap_stop_out"), "-q"])
+last = sorted(glob.glob(os.path.join(work, "gap_stop_out", "frame_*.vtu")))
+ok = p.returncode == 3 and len(last) > 0
+ck.le("a stopped run's last frame: largest |signed_distance| of a plate lying on a rising plane [m]",
+      np.abs(np.asarray(meshio.read(last[-1]).point_data["signed_distance"]).ravel()).max() if ok else 1.0, 1e-12)
 ck.finish()

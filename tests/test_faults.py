@@ -228,11 +228,20 @@ if restart_into("moved", "restart into a new folder", new_out):
 gone_out = os.path.join(work, "history_gone")
 shutil.copytree(part_out, gone_out)
 os.remove(os.path.join(gone_out, "history.dat"))
-frame0 = open(os.path.join(gone_out, "frame_00000.vtu"), "rb").read()
+with open(os.path.join(gone_out, "stopped.txt"), "w") as f:
+    f.write("this run stopped at t = 1 s of t_end = 2 s: a record the refusal must keep\n")
+
+
+def folder(path):
+    return {n: open(os.path.join(path, n), "rb").read() for n in sorted(os.listdir(path))}
+
+
+held = folder(gone_out)
 p = run([casca, "run", deck("gone", out=gone_out), "-q", "--restart", os.path.join(gone_out, "checkpoint.h5")])
-ck.record("restart in place with history.dat gone: refused (exit 2, 'is missing'), frame 0 unchanged",
-          p.returncode == 2 and "history.dat is missing" in p.stderr and clean(p)
-          and open(os.path.join(gone_out, "frame_00000.vtu"), "rb").read() == frame0, first_line(p))
+ck.record("restart in place with history.dat gone: refused (exit 2, 'is missing'), the folder as it was "
+          "(every file's name and bytes, its stopped.txt too)",
+          p.returncode == 2 and "history.dat is missing" in p.stderr and clean(p) and folder(gone_out) == held,
+          first_line(p) + " " + str(sorted(set(held) ^ set(folder(gone_out)))))
 
 # --- a restart into a folder that holds another run's results: the history before the
 # checkpoint is the checkpoint folder's, not the folder's own (the stale rows, here the

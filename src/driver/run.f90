@@ -349,6 +349,11 @@ contains
         if (allocated(r%contact)) contact_before = r%contact
         call newmark_step(model, r%asm, r%ls, nm, r%fext, r%opts, st, rep, r%err, r%contact)
         if (allocated(r%err)) then
+          if (saddle_instead()) then   ! (the same step, the constraints in the factorised matrix)
+            call undo_step()
+            deallocate (r%err)
+            cycle
+          end if
           if (may_cut()) then
             call cut_step(r%err%message)   ! (the state is unchanged)
             deallocate (r%err)
@@ -389,6 +394,7 @@ contains
           cycle
         end if
         energy_cut = .false.
+        r%ls%saddle_steps = max(r%ls%saddle_steps - 1, 0)
         r%total_newton = r%total_newton + rep%iters
         if (r%sc%tol > 0) then
           r%level = 0
@@ -416,6 +422,20 @@ contains
       if (is_root() .and. .not. r%quiet) print '(a,es10.3,a,a)', 'step cut to dt = ', &
         merge(r%dt_try, r%deck%run%dt/2**r%level, r%sc%tol > 0), ': ', why
     end subroutine cut_step
+
+    !> solver = 'auto' on the Schur path, whose S was singular: K near-singular where the
+    !> constraints hold it (S's largest eigenvalues blow up) looks like dependent rows; the
+    !> saddle-point matrix is regular there, so the step is taken again with it, and the next
+    !> saddle_hold steps too
+    logical function saddle_instead()
+      integer, parameter :: saddle_hold = 20
+      saddle_instead = r%ls%auto .and. r%ls%schur .and. r%ls%saddle_steps == 0 .and. &
+                       r%asm%ngroups == 1 .and. index(r%err%message, 'singular Schur complement') > 0
+      if (.not. saddle_instead) return
+      r%ls%saddle_steps = saddle_hold + 1
+      if (is_root() .and. .not. r%quiet) print '(a)', 'step taken again with the whole saddle-point '// &
+        'matrix: '//r%err%message
+    end function saddle_instead
 
     !> the step may be halved again: at most max_step_cuts times in a row, and with the error
     !> control not below its shortest step halved as often again (accepted slivers between
@@ -1086,6 +1106,10 @@ contains
         'past its static cone drops at once to the dynamic coefficient and sheds its load onto '// &
         'its neighbours, which may slip in turn within the step; friction_decay (&contact, '// &
         'e.g. 100 s/m) lets the drop follow the slip speed (README)'
+    else if (is_root() .and. index(reason, 'singular Schur complement') > 0 .and. .not. r%ls%auto) then
+      write (0, '(a)') 'hint: the Schur complement C K^-1 C^T fails where the stiffness K is '// &
+        'near-singular in directions the contacts hold (a buckled shell); solver = ''saddle'' '// &
+        '(&contact) factorises the whole saddle-point matrix, which is regular there'
     else if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') then
       write (0, '(a)') 'hint: '//r%nm%describe()//' keeps the shells'' fastest vibrations '// &
         'undamped, which can stall Newton; rho_inf = 0.8 (generalized-alpha) damps them, '// &
@@ -1129,6 +1153,7 @@ contains
     character(len=*), intent(in) :: reason
     type(error_t), allocatable :: e
     character(len=:), allocatable :: where_kept
+    if (allocated(r%contact)) r%contact%time = r%st%t   ! (a failed step left its end's)
     call frame(r)
     call checkpoint(r)
     call r%ls%finish()

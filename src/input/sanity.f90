@@ -273,6 +273,8 @@ contains
       select case (o%shape)
       case ('plane')
         call unit_vector(o%line, '&obstacle: normal', o%normal)
+        if (o%inside) call add_problem(deck, o%line, '&obstacle: inside is for a sphere or a '// &
+          'cylinder (a container); a plane''s side is its normal''s')
       case ('sphere')
         call positive(o%line, '&obstacle: radius', o%radius)
       case ('cylinder')

@@ -141,9 +141,6 @@ contains
     if (allocated(err)) return
     out%locked = .true.
     if (note /= '') write (0, '(a)') 'warning: '//note
-    call delete_file(out%dir//'/'//stopped_name)   ! (an earlier run's)
-    call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
-    if (allocated(err)) return
     cols = history_columns(size(tracked), bodies, pairs, friction, moving, compliant)
     ! a restart carries on the checkpoint folder's history, and into another folder leaves
     ! its frames there: what the other folder held is not taken (another run's rows were kept
@@ -163,6 +160,10 @@ contains
                        'new folder (--out)')
       return
     end if
+    ! (from here the folder is this run's: a refused restart leaves it as it was)
+    call delete_file(out%dir//'/'//stopped_name)   ! (an earlier run's)
+    call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
+    if (allocated(err)) return
     if (restart_step < 0 .or. file_kind(earlier) == kind_missing) then
       call cf_open(out%hist, out%dir//'/history.dat', 'w', err)
       if (allocated(err)) return

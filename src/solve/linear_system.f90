@@ -57,6 +57,11 @@ module casca_linear_system
     !> worse, three factorisations a step instead of one)
     integer :: fresh_left = 0, fresh_run = 0
     logical :: probing = .false.
+    !> auto takes the whole saddle-point matrix for this many more steps: S = C K^-1 C^T
+    !> failed where K is near-singular in directions the constraints hold, as a buckled ring
+    !> crushed between planes (20 contacts on 20 nodes were called dependent; the saddle-point
+    !> matrix went on). Reset with the factors, so a restart takes the same path.
+    integer :: saddle_steps = 0
   contains
     procedure :: finish => system_finish
     procedure :: drop_factors => system_drop_factors
@@ -81,7 +86,9 @@ contains
     integer, allocatable :: perm(:), irn(:), jcn(:), cirn(:), cjcn(:)
     integer :: nf, n, off, s, i
     logical :: same
-    if (ls%auto) then
+    if (ls%auto .and. ls%saddle_steps > 0 .and. asm%ngroups == 1) then
+      ls%schur = .false.
+    else if (ls%auto) then
       call choose_solver(ls%choice, rows%irn, rows%jcn, rows%val, rows%fval, rows%key, ls%refactored, &
                          asm%ngroups == 1, ls%schur)
       ls%refactored = .false.
@@ -291,6 +298,7 @@ contains
       self%choice = fresh
       self%schur = .true.
     end if
+    self%saddle_steps = 0
     self%fresh_left = 0; self%fresh_run = 0; self%probing = .false.
   end subroutine system_drop_factors
 

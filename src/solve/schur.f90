@@ -7,8 +7,11 @@
 !> when K is and the constraints are independent, so it is factorised by Cholesky, whose
 !> success is the inertia check (the saddle-point matrix then has K's inertia plus nc
 !> negative eigenvalues). When Cholesky fails (K indefinite, as past a limit point) S is
-!> decomposed into eigenvalues; a (nearly) singular S means dependent constraints and is an
-!> error that cuts the step, never a silent zero correction.
+!> decomposed into eigenvalues; a (nearly) singular S, relative to its largest eigenvalue,
+!> means dependent constraints, or K near-singular where they hold it (S's largest
+!> eigenvalues blow up: a buckled ring between planes), and is an error that cuts the step
+!> (under solver = 'auto', takes it again through the saddle-point matrix), never a silent
+!> zero correction.
 module casca_schur
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
@@ -232,7 +235,8 @@ contains
 
     subroutine dependent()
       c%current = .false.
-      call fatal_error(err, 'contact constraints are dependent (singular Schur complement)')
+      call fatal_error(err, 'singular Schur complement of the contact constraints (they are dependent, '// &
+                       'or the stiffness is near-singular where they hold it)')
     end subroutine dependent
   end subroutine factorise_s
 
