@@ -35,7 +35,7 @@ fold       a long strip (h 2 mm, width 20 mm, steel with nu 0, 60 x 2 elements) 
            within 2% of that (the rest is the legs' rotation, about 0.1 rad, which the linear
            answer leaves out), no tensile multiplier, and the loaded tip's mid-surface at least
            0.9 h above the nearest node of the other leg (the faces do not pass each other).
-crush      a thin ring (R 50 mm, h 2 mm, width 20 mm, E 2 GPa, 40 elements) crushed flat between two
+thin_fold  a thin ring (R 50 mm, h 2 mm, width 20 mm, E 2 GPa, 40 elements) crushed flat between two
            rigid planes closing at 1 m/s each, self-contact, the thesis Newmark at 0.25 ms, to
            48 ms (a helper's scene written from the README): its ends fold to a radius near the
            thickness, where the inner face is compressed along itself past what the
@@ -48,7 +48,7 @@ crush      a thin ring (R 50 mm, h 2 mm, width 20 mm, E 2 GPa, 40 elements) crus
            one step; the least it gives (at a node) is within [-6, +1] points of per cent of the
            frames' least (a chord averages the stretch over a third of an element, where the
            fold's radius is about that long, so it reads higher than at the node).
-thin crush a thin steel ring (R 30 mm, h 1 mm, width 10 mm, 32 cells) crushed between two planes
+thin_crush a thin steel ring (R 30 mm, h 1 mm, width 10 mm, 32 cells) crushed between two planes
            closing at 1 m/s each, no self-contact, the thesis Newmark at 0.1 ms, to 28 ms (a
            helper's scene): it runs to the end (casca before 2026-11-29 stopped at 26.6 ms with
            "contact constraints are dependent": its buckled walls made K near-singular where
@@ -200,23 +200,31 @@ if out is not None:
     ck.le("fold: h minus the loaded tip's distance above the other leg, over h",
           (hf - (hist["p1_y"][-1] - hist["p2_y"][-1])) / hf, 0.1)
 
-# --- a thin ring crushed flat: its folds pass the material law's range along their faces
-deck = os.path.join(work, "crush.nml")
-with open(deck, "w") as f:
-    f.write("""&run dt = 2.5e-4, t_end = 0.048 /
-&output interval = 2.5e-4, vtu = .true., plots = .false. /
-&body name = 'ring', mesh = 'ring', radius = 0.05, width = 0.02, n_around = 40, n_across = 1,
-  young = 2.0e9, poisson = 0.3, density = 1000, thickness = 0.002 /
-&obstacle name = 'top', shape = 'plane', point = 0.0, 0.051, 0.0, normal = 0.0, -1.0, 0.0,
+
+def crushed_ring(name, radius, width, cells, material, h, gap, dt, t_end, interval, selfc, vtu=False):
+    """Run a ring (axis z) between two planes closing at 1 m/s each from gap off its faces:
+    (exit code, stderr, output folder)"""
+    deck = os.path.join(work, name + ".nml")
+    y = radius + h / 2 + gap
+    with open(deck, "w") as f:
+        f.write(f"""&run dt = {dt}, t_end = {t_end} /
+&output interval = {interval}, vtu = {'.true.' if vtu else '.false.'}, plots = .false. /
+&body name = 'ring', mesh = 'ring', radius = {radius}, width = {width}, n_around = {cells}, n_across = 1,
+  {material}, thickness = {h} /
+&obstacle name = 'top', shape = 'plane', point = 0.0, {y}, 0.0, normal = 0.0, -1.0, 0.0,
   velocity = 0.0, -1.0, 0.0 /
-&obstacle name = 'bottom', shape = 'plane', point = 0.0, -0.051, 0.0, normal = 0.0, 1.0, 0.0,
+&obstacle name = 'bot', shape = 'plane', point = 0.0, {-y}, 0.0, normal = 0.0, 1.0, 0.0,
   velocity = 0.0, 1.0, 0.0 /
-&contact pairs = 'ring', 'ring' /
-""")
-out = os.path.join(work, "crush")
-p = run([casca, "run", deck, "--out", out, "-q"])
-ck.record("crush: runs to the end (exit 0)", p.returncode == 0, p.stderr[-300:])
-if p.returncode == 0:
+""" + ("&contact pairs = 'ring', 'ring' /\n" if selfc else ""))
+    out = os.path.join(work, name)
+    p = run([casca, "run", deck, "--out", out, "-q"])
+    return p.returncode, p.stderr, out
+
+# --- a thin ring crushed flat: its folds pass the material law's range along their faces
+code, err, out = crushed_ring("thin_fold", 0.05, 0.02, 40, "young = 2.0e9, poisson = 0.3, density = 1000", 0.002,
+                              0.0, 2.5e-4, 0.048, 2.5e-4, True, vtu=True)
+ck.record("thin_fold: runs to the end (exit 0)", code == 0, err[-300:])
+if code == 0:
     hc = 0.002
     root = ET.parse(os.path.join(out, "run.pvd")).getroot()
     least, first = [], None
@@ -237,54 +245,36 @@ if p.returncode == 0:
                             np.linalg.norm(np.roll(y0, -1, 0) - y0, axis=1)).min())
         least.append((float(d.get("timestep")), s))
     least = np.array(least)
-    warned = re.search(r"compressed along its face to (\d+)%.*below 58% from t = (\S+) s", p.stderr)
-    ck.record("crush: casca warns of the face's compression", warned is not None, p.stderr[-400:])
+    warned = re.search(r"compressed along its face to (\d+)%.*below 58% from t = (\S+) s", err)
+    ck.record("thin_fold: casca warns of the face's compression", warned is not None, err[-400:])
     below = least[least[:, 1] < 1 / math.sqrt(3), 0]
-    ck.record("crush: the frames show a face below 1/sqrt(3)", len(below) > 0, "least %.3f" % least[:, 1].min())
+    ck.record("thin_fold: the frames show a face below 1/sqrt(3)", len(below) > 0, "least %.3f" % least[:, 1].min())
     if warned and len(below):
-        ck.le("crush: |first time below 58%, warned - frames'| [s]", abs(float(warned.group(2)) - below[0]), 2.6e-4)
+        ck.le("thin_fold: |first time below 58%, warned - frames'| [s]", abs(float(warned.group(2)) - below[0]), 2.6e-4)
         d = int(warned.group(1)) - 100 * least[:, 1].min()
-        ck.record("crush: warned least - frames' least in [-6, 1] points of per cent (%.2f)" % d, -6 <= d <= 1)
+        ck.record("thin_fold: warned least - frames' least in [-6, 1] points of per cent (%.2f)" % d, -6 <= d <= 1)
 
 # --- a thin ring crushed by two planes: its buckled walls make K near-singular
-out = go("thin_crush", """&run dt = 1.0e-4, t_end = 0.028 /
-&output interval = 1.5e-3, vtu = .false., plots = .false. /
-&body name = 'ring', mesh = 'ring', radius = 0.03, width = 0.01, n_around = 32, n_across = 1,
-  young = 210e9, poisson = 0.3, density = 7800, thickness = 0.001 /
-&obstacle name = 'top', shape = 'plane', point = 0.0, 0.0307, 0.0, normal = 0.0, -1.0, 0.0,
-  velocity = 0.0, -1.0, 0.0 /
-&obstacle name = 'bot', shape = 'plane', point = 0.0, -0.0307, 0.0, normal = 0.0, 1.0, 0.0,
-  velocity = 0.0, 1.0, 0.0 /
-""")
-if out is not None:
+code, err, out = crushed_ring("thin_crush", 0.03, 0.01, 32, STEEL.replace("7700", "7800"), 0.001, 0.0002,
+                              1.0e-4, 0.028, 1.5e-3, False)
+ck.record("thin_crush: runs to the end (exit 0)", code == 0, err[-300:])
+if code == 0:
     hist = history(out)
     ftop, fbot = hist["fcontact_ring_top"], hist["fcontact_ring_bot"]
-    ck.le("thin crush: max |f_top - f_bot| / max f", np.abs(ftop - fbot).max() / ftop.max(), 1e-9)
+    ck.le("thin_crush: max |f_top - f_bot| / max f", np.abs(ftop - fbot).max() / ftop.max(), 1e-9)
     itop, ibot = hist["impulse_ring_top"], hist["impulse_ring_bot"]
-    ck.le("thin crush: |impulse_top - impulse_bot| / impulse at the end", abs(itop[-1] - ibot[-1]) / itop[-1], 1e-9)
-    ck.le("thin crush: max |py| / impulse at the end", np.abs(hist["py"]).max() / itop[-1], 1e-9)
-    ck.le("thin crush: max (K + S - planes' work) / planes' work at the end",
+    ck.le("thin_crush: |impulse_top - impulse_bot| / impulse at the end", abs(itop[-1] - ibot[-1]) / itop[-1], 1e-9)
+    ck.le("thin_crush: max |py| / impulse at the end", np.abs(hist["py"]).max() / itop[-1], 1e-9)
+    ck.le("thin_crush: max (K + S - planes' work) / planes' work at the end",
           (hist["kinetic"] + hist["strain"] - hist["obstacle_work"]).max() / hist["obstacle_work"][-1], 1e-9)
 
 # --- a ring flattened past what its material holds: the stop names it, its frame is sound
-flat_deck = os.path.join(work, "flatten.nml")
-with open(flat_deck, "w") as f:
-    f.write("""&run dt = 1.0e-4, t_end = 0.0285 /
-&output interval = 1.5e-3, plots = .false. /
-&body name = 'ring', mesh = 'ring', radius = 0.03, width = 0.01, n_around = 32, n_across = 1,
-  young = 210e9, poisson = 0.3, density = 7800, thickness = 0.003 /
-&obstacle name = 'top', shape = 'plane', point = 0.0, 0.0317, 0.0, normal = 0.0, -1.0, 0.0,
-  velocity = 0.0, -1.0, 0.0 /
-&obstacle name = 'bot', shape = 'plane', point = 0.0, -0.0317, 0.0, normal = 0.0, 1.0, 0.0,
-  velocity = 0.0, 1.0, 0.0 /
-&contact pairs = 'ring', 'ring' /
-""")
-out = os.path.join(work, "flatten")
-p = run([casca, "run", flat_deck, "--out", out, "-q"])
+code, err, out = crushed_ring("flatten", 0.03, 0.01, 32, STEEL.replace("7700", "7800"), 0.003, 0.0002,
+                              1.0e-4, 0.0285, 1.5e-3, True, vtu=True)
 ck.record("flatten: stops (exit 3) with a hint naming the face's compression",
-          p.returncode == 3 and "compressed along its face" in p.stderr, p.stderr[-300:])
+          code == 3 and "compressed along its face" in err, err[-300:])
 last = sorted(f for f in os.listdir(out) if f.startswith("frame_")) if os.path.isdir(out) else []
-if p.returncode == 3 and last:
+if code == 3 and last:
     sd = np.asarray(meshio.read(os.path.join(out, last[-1])).point_data["signed_distance"]).ravel()
     ck.le("flatten: the stop frame's most negative signed_distance, less than -1e-9 m [m]", max(-sd.min() - 1e-9, 0.0), 0.0)
 ck.finish()
