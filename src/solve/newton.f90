@@ -29,6 +29,7 @@
 module casca_newton
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
+  use casca_strings, only: itoa
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t, assemble
   use casca_pressure_assembly, only: add_pressure   ! follower pressure (issue 17)
@@ -548,5 +549,8 @@ contains
       ' iterations (last increment ', rep%incr(max(rep%nincr, 1)), &
       ' of the scene size, residual ', rnorm/max(fref, tiny(1._dp)), ' of the scene force)'
     msg = trim(buf)
+    ! (newton_max_iter is each active set's; a reader of 100 looked for a 100 in the deck)
+    if (rep%iters >= max_hist) msg = msg//'; '//itoa(max_hist)//' is the most a step takes '// &
+                                     'over all its active sets'
   end function failure_message
 end module casca_newton
