@@ -51,24 +51,15 @@ contains
     end if
   end subroutine obstacle_point
 
-  !> The first time t >= 0 at which a point at x moving at w relative to the obstacle comes
-  !> within off of its surface (0 if it is within already); -1 if it never does. Exact for
-  !> each shape: a path aimed past a sphere's centre meets its wall later than its distance
-  !> over the closing speed says (a ball inside a spherical shell: 21.3 ms for 18.6).
+  !> The first time t >= 0 at which a point at x moving at w relative to a sphere or a
+  !> cylinder comes within off of its wall (0 if it is within already); -1 if it never does.
+  !> A path aimed past the centre meets the wall later than its distance over the closing
+  !> speed says (a ball inside a spherical shell: 21.3 ms for 18.6); a plane's is that ratio.
   pure real(dp) function obstacle_ray_time(ob, x, w, off) result(t)
     type(obstacle_t), intent(in) :: ob
     real(dp), intent(in) :: x(3), w(3), off
-    real(dp) :: r(3), u(3), rho, a, b, disc, d, n(3)
+    real(dp) :: r(3), u(3), rho, a, b, disc
     t = -1
-    if (ob%shape == 'plane') then
-      call obstacle_point(ob, 0._dp, x, n, d)
-      if (d <= off) then
-        t = 0
-      else if (dot_product(w, n) < 0) then
-        t = (d - off)/(-dot_product(w, n))
-      end if
-      return
-    end if
     r = x - ob%point; u = w
     if (ob%shape == 'cylinder') then   ! (across the axis)
       r = r - dot_product(r, ob%normal)*ob%normal; u = u - dot_product(u, ob%normal)*ob%normal

@@ -101,7 +101,7 @@ module casca_run
     !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact: not watched
     logical :: held_at_start = .false.
     !> the least stretches the run's states reached, through the thickness and along the
-    !> faces, where and when (watch_thickness)
+    !> faces, where and when (watch_thickness, watch_faces)
     type(least_t) :: thick, face
     type(output_t) :: out
     type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
@@ -544,7 +544,7 @@ contains
     call timer_stop(t_output)
     if (failed(r, 'history')) return
     if (r%st%t >= next_frame - 1e-6_dp*dt .or. r%st%t >= r%deck%run%t_end - 1e-6_dp*dt) then
-      call watch_thickness(r, faces=.true.)
+      call watch_faces(r)
       call timer_start(t_output)
       call frame(r)
       call timer_stop(t_output)
@@ -580,7 +580,7 @@ contains
         st%t = real(i, dp)/deck%run%load_steps; st%step = i
         call account_state(r, factor=st%t)   ! (issue 17)
         call watch_thickness(r)
-        call watch_thickness(r, faces=.true.)
+        call watch_faces(r)
         call history_row(r, r%rep%iters)
         if (failed(r, 'history')) return
         call frame(r)
@@ -1090,9 +1090,8 @@ contains
     reason = why   ! (why may be r%err's message, which the frame and checkpoint below reset)
     if (is_root()) write (0, '(a)') 'error: the solver cannot go on '//when(r)//': '//reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
-    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
-    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_coulomb(r)
-    call watch_thickness(r, faces=.true.)   ! (the last good state)
+    call warn_dynamic(r)
+    call watch_faces(r)   ! (the last good state)
     call keep_and_stop(r, reason)
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
     ! flight after the bounce; gamma 0.6 ran it through, docs/method.md)
@@ -1192,8 +1191,7 @@ contains
       if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//r%dir// &
         '/plots.gp was written but not run'
     end if
-    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_energy(r)
-    if (is_root() .and. r%deck%run%analysis /= 'static') call warn_coulomb(r)
+    call warn_dynamic(r)
     if (is_root() .and. squeezed(r)) write (0, '(a)') 'warning: '//squeeze_note(r)
     if (.not. is_root() .or. r%quiet) return
     associate (deck => r%deck, model => r%model)
@@ -1242,29 +1240,34 @@ contains
     end subroutine count_active
   end subroutine watch_energy
 
-  !> Keep the least stretch of the run's states through the thickness (thinnest; every step)
-  !> or along the faces (least_face_stretch; faces: at the frames' times and where the run
-  !> ends or stops, as it costs about 0.6 us an element, 1.5% of a step of the three spheres)
-  subroutine watch_thickness(r, faces)
+  !> Keep the least thickness stretch of the run's states (thinnest; every step)
+  subroutine watch_thickness(r)
     type(run_t), intent(inout) :: r
-    logical, intent(in), optional :: faces
     real(dp) :: stretch
     integer :: node
-    if (present(faces)) then
-      if (.not. (allocated(r%model%face_metric) .and. allocated(r%st%q))) return   ! (stopped before)
-      call least_face_stretch(r%model, r%st%q, node, stretch)
-      call keep(r%face)
-      return
-    end if
     call thinnest(r%model, r%st%q, node, stretch)
-    call keep(r%thick)
-  contains
-    subroutine keep(least)
-      type(least_t), intent(inout) :: least
-      if (stretch < svk_limit .and. least%t_past < 0) least%t_past = r%st%t
-      if (stretch < least%stretch) least = least_t(stretch, r%st%t, node, least%t_past)
-    end subroutine keep
+    call keep_least(r%thick, stretch, node, r%st%t)
   end subroutine watch_thickness
+
+  !> Keep the least stretch along the faces (least_face_stretch): at the frames' times and where
+  !> the run ends or stops, as it costs about 0.6 us an element, 1.5% of a step of the three
+  !> spheres
+  subroutine watch_faces(r)
+    type(run_t), intent(inout) :: r
+    real(dp) :: stretch
+    integer :: node
+    if (.not. (allocated(r%model%face_metric) .and. allocated(r%st%q))) return   ! (stopped before)
+    call least_face_stretch(r%model, r%st%q, node, stretch)
+    call keep_least(r%face, stretch, node, r%st%t)
+  end subroutine watch_faces
+
+  pure subroutine keep_least(least, stretch, node, t)
+    type(least_t), intent(inout) :: least
+    real(dp), intent(in) :: stretch, t
+    integer, intent(in) :: node
+    if (stretch < svk_limit .and. least%t_past < 0) least%t_past = t
+    if (stretch < least%stretch) least = least_t(stretch, t, node, least%t_past)
+  end subroutine keep_least
 
   !> A shell squeezed past Saint-Venant-Kirchhoff's limit (svk_limit), through its thickness
   !> or along a face: squeezed further its stress falls, so the equations lose their solution
@@ -1335,6 +1338,14 @@ contains
     type(run_t), intent(in) :: r
     step_judged = r%st%step > merge(1, 0, r%held_at_start)
   end function step_judged
+
+  !> What a dynamic run warns of at its end or stop (rank 0): energy made, Coulomb's bound
+  subroutine warn_dynamic(r)
+    type(run_t), intent(in) :: r
+    if (.not. is_root() .or. r%deck%run%analysis == 'static') return
+    call warn_energy(r)
+    call warn_coulomb(r)
+  end subroutine warn_dynamic
 
   !> Coulomb's bound over the run, where it can be read from the impulse column: a pair with a
   !> plane obstacle (one normal) takes at most mu times its normal impulse along the plane. The

@@ -81,15 +81,12 @@ contains
     real(dp), intent(in) :: q(:)
     integer, intent(out) :: node
     real(dp), intent(out) :: stretch
-    real(dp) :: qe(ndof_node, nen), s
-    integer :: e, l, n
+    real(dp) :: s
+    integer :: e, n
     node = 0; stretch = huge(1._dp)
     do e = 1, model%nelem
-      do l = 1, nen
-        qe(:, l) = q(dof(model%conn(l, e), 1):dof(model%conn(l, e), ndof_node))
-      end do
-      call shell_face_stretch(model%rule, model%face_metric(:, :, :, e), &
-                              model%body(model%elem_body(e))%thickness, qe, s, n)
+      call shell_face_stretch(model%rule, model%face_metric(:, :, :, e), model%body(model%elem_body(e))%thickness, &
+                              reshape(q(element_dofs(model, e)), [ndof_node, nen]), s, n)
       if (s < stretch) then
         stretch = s; node = model%conn(n, e)
       end if
