@@ -203,7 +203,7 @@ contains
         'casca mesh ring   --radius R --width W --n-around N --n-across M -o FILE.msh', &
         'casca mesh sphere --radius R --n-div N -o FILE.msh', &
         'casca mesh plate|strip --lx A --ly B --nx N --ny M -o FILE.msh', &
-        'casca mesh KIND ... --size H -o FILE.msh      (counts for element edges of about H)', &
+        'casca mesh KIND ... --size H -o FILE.msh      (counts for cells of sides about H)', &
         '', &
         'Writes a mesh of 10-node (cubic) triangles to FILE.msh (Gmsh MSH 4.1) for a deck''s', &
         '&body mesh = ''file''. Sizes in m; each grid cell is two triangles.', &
@@ -214,10 +214,11 @@ contains
         '  plate    rectangle [0,A] x [0,B] (1 x 1) in the xy plane, N (4) by M (1) cells;', &
         '  strip    the same', &
         'options:', &
-        '  --size H          the counts for element edges of at most about H [m], as a deck''s', &
+        '  --size H          the counts for grid cells of sides at most about H [m] (their', &
+        '                    diagonal, also an element edge, is up to 1.41 H), as a deck''s', &
         '                    element_size: ring 2 pi R / H around and W / H across, sphere', &
-        '                    (R / sin 72 deg) / H per icosahedron edge, plate A / H by B / H,', &
-        '                    rounded up; it replaces the counts given', &
+        '                    (R / sin 72 deg) / H per icosahedron edge (its triangles'' edges), plate', &
+        '                    A / H by B / H, rounded up; it replaces the counts given', &
         '  -o, --out FILE    the mesh file to write (required)', &
         '  -h, --help        this text', &
         'exit codes: 0 written, 2 bad input']

@@ -67,6 +67,13 @@ def history(folder):
     return {n: data[:, i] for i, n in enumerate(names)}
 
 
+def loaded(h):
+    """A static run's history from its first load step on: its row 0 is the unloaded state
+    (load factor 0), where ratios to the load are 0 / 0."""
+    keep = h["t"] > 0
+    return {k: v[keep] for k, v in h.items()}
+
+
 def momentum_error(h):
     """Largest change of the total linear momentum over the run, relative to the initial."""
     p = np.stack([h["px"], h["py"], h["pz"]]).T

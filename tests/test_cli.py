@@ -20,7 +20,9 @@ Asserted about the command line itself (issue 17):
 - gnuplot's messages stay off the terminal: `casca run` of the static cantilever example (flat
   energy curves, on which gnuplot warns "empty y range") and `casca plot` of its folder exit 0
   with no "empty y range" in their stdout or stderr, and the warning is in the folder's
-  gnuplot.log instead (so the scene does provoke it).
+  gnuplot.log instead (so the scene does provoke it). Its history's row 0 is load factor 0 with
+  the tracked tip at (10, ., 0), frame 0 has no displacement, the tip's u_z from row 0 to the
+  last is Sze's 6.698 (1%), and plots.gp plots against the load factor.
 - a misspelt body name (in &restraint, in &contact pairs) or key is named with the nearest
   one: "(did you mean 'ring2'?)", "(did you mean 'tolerance'?)"; a key of another group with
   that group: a body's pressure, "(a key of &load)"; a list where one string goes (fix =
@@ -30,11 +32,15 @@ Asserted about the command line itself (issue 17):
 - a `&restraint` or `&load` given a box and a node list exits 2 at its line (each selects on
   its own; the box was dropped); a run into a folder that holds another run's 7 frames
   leaves its own 2 there, exactly those its run.pvd lists.
+- frames with fixed steps: an interval of 12.5 steps of dt is warned of by `casca check` (with
+  the ratio, 12.500) and the run, whose frames are at the first step ends at or past 0, 0.5 and
+  1 ms (0, 0.52, 1.0 ms); an interval of 12 steps is not warned of.
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
 """
 import glob
+import math
 import os
 import re
 import shutil
@@ -347,6 +353,34 @@ if p.returncode == 0:
 else:
     ck.record("a plate 1 mm above a plane runs (exit 0)", False, p.stderr[-300:])
 
+# frames with fixed steps that do not divide the interval: written at the end of the first
+# step at or past each frame's time, and casca check and the run say so (a helper's frames
+# came at 0.52, 1.00, 1.52 ms for a 0.5 ms interval with no word, 2026-11-29)
+for interval, dt in ((5.0e-4, 4.0e-5), (4.8e-4, 4.0e-5)):
+    odd_deck = os.path.join(work, "odd_interval.nml")
+    with open(odd_deck, "w") as f:
+        f.write("&run dt = %g, t_end = 1.0e-3 /\n&output interval = %g, plots = .false. /\n"
+                "&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 1, ny = 1,\n"
+                "  velocity = 0.0, 0.0, 1.0, young = 210e9, poisson = 0.3, density = 7700, thickness = 0.01 /\n"
+                % (dt, interval))
+    steps = interval / dt
+    whole = abs(steps - round(steps)) < 1e-9
+    p = run([casca, "check", odd_deck])
+    said = re.search(r"&output interval \S+ s is (\S+) steps of dt", p.stderr)
+    if whole:
+        ck.record("interval %g = %d steps of dt %g: casca check does not warn" % (interval, round(steps), dt),
+                  p.returncode == 0 and said is None, p.stderr[-300:])
+        continue
+    ck.record("interval %g = %.3f steps of dt %g: casca check warns with that ratio" % (interval, steps, dt),
+              p.returncode == 0 and said is not None and abs(float(said.group(1)) - steps) < 1e-3, p.stderr[-300:])
+    odd_out = os.path.join(work, "odd_interval_out")
+    p = run([casca, "run", odd_deck, "--out", odd_out, "-q"])
+    times = [float(d.get("timestep")) for d in ET.parse(os.path.join(odd_out, "run.pvd")).getroot().iter("DataSet")]
+    expected = [math.ceil(k * interval / dt - 1e-9) * dt for k in range(3)]
+    ck.record("the run warns too", "steps of dt" in p.stderr, p.stderr[-300:])
+    ck.record("its frames are at the first step ends at or past 0, %g, %g s: %s" % (interval, 2 * interval, expected),
+              len(times) == 3 and max(abs(a - b) for a, b in zip(times, expected)) < 1e-12, str(times))
+
 # a run into a folder that holds a longer run's frames: only its own stay (before 2026-11-29
 # frames 2..6 of the other run stayed beside its 2, and ParaView's frame_* series mixed them)
 stale = os.path.join(work, "stale_out")
@@ -415,6 +449,21 @@ ck.record("gnuplot's 'empty y range' warning is in DIR/gnuplot.log",
 p = run([casca, "plot", out_c])
 ck.record("casca plot of it: exit 0, no 'empty y range' on the terminal",
           p.returncode == 0 and "empty y range" not in p.stdout + p.stderr, (p.stdout + p.stderr)[-300:])
+# a static run starts at load factor 0, undeformed: its plots measure the displacement from
+# there (before 2026-11-29 from the first load step: the tip's 6.70 plotted as 5.39) against
+# the load factor
+if p.returncode == 0:
+    hc = history(out_c)
+    ck.record("static cantilever: history row 0 is load factor 0 with the tip where the deck puts it",
+              hc["t"][0] == 0 and hc["p1_x"][0] == 10.0 and hc["p1_z"][0] == 0.0,
+              "t %g, tip (%g, %g)" % (hc["t"][0], hc["p1_x"][0], hc["p1_z"][0]))
+    ck.close("static cantilever: the tip's u_z from row 0 to the last (displacements.png) against Sze's 6.698",
+             hc["p1_z"][-1] - hc["p1_z"][0], 6.698, 0.01)
+    m0 = meshio.read(os.path.join(out_c, "frame_00000.vtu"))
+    ck.le("static cantilever: frame 0's largest |displacement| (undeformed) [m]",
+          np.abs(m0.point_data["displacement"]).max(), 0.0)
+    gp = open(os.path.join(out_c, "plots.gp")).read()
+    ck.record("static cantilever: plots.gp plots against the load factor", "set xlabel 'load factor [-]'" in gp)
 
 # --- restart: a run stopped at 1.5 ms and continued equals the uninterrupted run (both write
 # a checkpoint at 1.5 ms: the step after a checkpoint starts with a new factorisation)

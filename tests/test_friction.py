@@ -152,6 +152,14 @@ backspin   the same hoop thrown at 2 m/s with 10 rad/s of backspin (its contact 
            per decision; stick/slip turns no longer count among a step's twelve decisions.)
 bad input  static_friction below friction, a negative friction, a negative friction_decay:
            exit 2 naming the field.
+symmetry   statics with friction where symmetry restraints pass through the contact (a helper's
+           scene): a ring (R 1 m, width 0.1 m, h 10 mm, E 1 GPa, nu 0, 48 x 2 cells) held at
+           x = 0 (x and its fibre's x) and z = 0 (z, fibre z) on a rigid plane with mu 0.3, a
+           force P = 0.05 N down at its top, 10 load steps: it runs (before 2026-11-29: 'the
+           tangent matrix is singular' at load factor 0.006, the bottom nodes' stick rows along
+           x held by the restraint alone); the plane's reaction is P (1e-9 relative) and the
+           vertical diameter shortens by the thin ring's (pi/4 - 2/pi) P R^3 / (E I),
+           I = b h^3 / 12 (0.5%).
 """
 import os
 import sys
@@ -517,6 +525,27 @@ for name, mu_s, th in (("incline_slide", 0.3, TH_P), ("incline_steep", 0.4, np.r
              % (name, mu_s, np.degrees(th)), (v[i1] - v[i0]) / (t[i1] - t[i0]),
              G * (np.sin(th) - MU_P * np.cos(th)), 0.01)
     ck.close("%s: speed at 0.1 s [m/s] vs a rigid plate's under mu(v)" % name, v[i1], rigid_speed(mu_s, th, t[i1]), 0.02)
+
+# statics with friction and symmetry restraints through the contact: the restraint holds the
+# stick row along x (left out), not half of two dependent rows
+out, _ = run_scene(casca, ck, work, "symmetry", """&run analysis = 'static' /
+&output plots = .false., vtu = .false., track = 0.0, 1.0, 0.0,  0.0, -1.0, 0.0 /
+&body name = 'ring', mesh = 'ring', radius = 1.0, width = 0.1, n_around = 48, n_across = 2,
+  young = 1.0e9, poisson = 0.0, density = 1000.0, thickness = 0.01 /
+&restraint body = 'ring', box_min = -1e-6, -2, -1, box_max = 1e-6, 2, 1, fix = 'x gx' /
+&restraint body = 'ring', box_min = -2, -2, -1e-6, box_max = 2, 2, 1e-6, fix = 'z gz' /
+&load body = 'ring', box_min = -1e-6, 0.99, -1, box_max = 1e-6, 1.01, 1, force = 0.0, -0.05, 0.0 /
+&obstacle name = 'floor', shape = 'plane', point = 0.0, -1.005, 0.0, normal = 0.0, 1.0, 0.0 /
+&contact friction = 0.3 /
+""")
+if out is not None:
+    h = history(out)
+    ck.close("symmetry: the plane's reaction equals P = 0.05 N", h["fcontact"][-1], 0.05, 1e-9)
+    shortening = (1.0 - h["p1_y"][-1]) - (-1.0 - h["p2_y"][-1])
+    ei = 1.0e9 * 0.1 * 0.01 ** 3 / 12
+    ck.close("symmetry: the vertical diameter's shortening against (pi/4 - 2/pi) P R^3 / (E I)",
+             shortening, (np.pi / 4 - 2 / np.pi) * 0.05 / ei, 5e-3)
+
 
 for name, fr, needles in (("static_friction below friction", "friction = 0.3, static_friction = 0.2",
                            ["&contact", "static_friction", "below"]),

@@ -56,7 +56,7 @@ import sys
 import h5py
 import numpy as np
 
-from casca_testlib import ENV, Checks, history, run, run_scene, svk_sphere_stretch
+from casca_testlib import ENV, Checks, history, loaded, run, run_scene, svk_sphere_stretch
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
 os.makedirs(work, exist_ok=True)
@@ -74,7 +74,7 @@ RING = f"""&run analysis = 'static', load_steps = 2 /
 length = np.sqrt(1 + 0.2**2 + 1)   # the ring's bounding-box diagonal
 out, _ = run_scene(casca, ck, work, "ring", RING)
 if out:
-    h = history(out)
+    h = loaded(history(out))
     ck.le("ring: floor's force vs the load, largest relative difference",
           np.max(np.abs(h["fcontact_ring_floor"] / (P * h["t"]) - 1)), 1e-9)
     ck.le("ring: lowest node vs the floor's surface z = -0.5 [m]", np.max(np.abs(h["p2_z"] + 0.5)), 1e-7 * length)
@@ -84,7 +84,7 @@ if out:
     p = run([casca, "run", os.path.join(work, "ring.nml"), "--out", os.path.join(work, "ring_np2"), "-q"], np_ranks=2)
     ck.record("ring on 2 ranks: exit 0", p.returncode == 0, p.stderr[-300:])
     if p.returncode == 0:
-        h2 = history(os.path.join(work, "ring_np2"))
+        h2 = loaded(history(os.path.join(work, "ring_np2")))
         ck.le("ring: tracked z on 2 ranks vs 1 [m]",
               max(np.abs(h2["p1_z"] - h["p1_z"]).max(), np.abs(h2["p2_z"] - h["p2_z"]).max()), 1e-10)
 
@@ -107,13 +107,13 @@ HELD = """&restraint body = 'plate', box_max = 0.0, 1e9, 1e9, fix = 'x y' /
 PRESS = f"&load body = 'plate', kind = 'pressure', pressure = {-PRESSURE:g} /"
 out, _ = run_scene(casca, ck, work, "plate", plate("plate", HELD, PRESS))
 if out:
-    h = history(out)
+    h = loaded(history(out))
     ck.le("plate: floor's force vs p A, largest relative difference",
           np.max(np.abs(h["fcontact_plate_floor"] / (PRESSURE * h["t"]) - 1)), 1e-6)
     ck.le("plate: mid-surface vs h/2 above the floor [m]", np.max(np.abs(h["p1_z"] + 0.003)), 1e-7 * np.sqrt(2))
 out, _ = run_scene(casca, ck, work, "free", plate("free", "", PRESS))
 if out:
-    h = history(out)
+    h = loaded(history(out))
     ck.le("free: floor's force vs p A, largest relative difference",
           np.max(np.abs(h["fcontact_plate_floor"] / (PRESSURE * h["t"]) - 1)), 1e-6)
     ck.le("free: sideways drift of the tracked node [m]",
@@ -127,7 +127,7 @@ CUP = """&run analysis = 'static', load_steps = 2, gravity = 0, 0, -9.81 /
 """
 out, _ = run_scene(casca, ck, work, "cup", CUP)
 if out:
-    h = history(out)
+    h = loaded(history(out))
     p = run([casca, "check", os.path.join(work, "cup.nml")])
     mass = [float(l.split("mass ")[1].split()[0]) for l in p.stdout.splitlines() if "body 'ball'" in l]
     ck.record("cup: casca check states the mass", len(mass) == 1, p.stdout[-300:])
@@ -182,7 +182,7 @@ SPHERE = f"""&run analysis = 'static', load_steps = 3 /
 """
 out, _ = run_scene(casca, ck, work, "sphere", SPHERE)
 if out:
-    h = history(out)
+    h = loaded(history(out))
     r = [np.sqrt(h["p%d_x" % k] ** 2 + h["p%d_y" % k] ** 2 + h["p%d_z" % k] ** 2) for k in (1, 2)]
     s = np.array([svk_sphere_stretch(3e8 * t, ES, NUS, HS, 1.0) for t in h["t"]])
     ck.le("sphere: stretch of tracked node 1 vs SVK, largest error / displacement",
@@ -198,7 +198,7 @@ def pushed(name, force):
 
 out, _ = run_scene(casca, ck, work, "stick", pushed("stick", 1500.0))
 if out:
-    h = history(out)
+    h = loaded(history(out))
     ck.le("stick: the floor's friction force vs the sideways load F t, largest relative difference",
           np.max(np.abs(h["ftangent_plate_floor"] / (1500.0 * h["t"]) - 1)), 1e-6)
     ck.le("stick: the plate has not slid: tracked x, y within F / (E h), the push's stretch [m]",

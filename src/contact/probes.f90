@@ -13,22 +13,30 @@ contains
 
   !> Deepest penetration of the impactor nodes that carry no constraint (their gap) or are
   !> held where they were (constraint_t%hold), and largest |gap| of those that carry one.
-  subroutine contact_penetration(c, model, q, free_pen, max_gap)
+  subroutine contact_penetration(c, model, q, free_pen, max_gap, deepest)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
     real(dp), intent(out) :: free_pen, max_gap
+    integer, intent(out), optional :: deepest   !< the node that penetrates free_pen (0: none)
     type(contact_t) :: probe
-    integer :: added, k
+    integer :: added, k, node
     ! a probe with no active constraint and zero tolerance detects every penetrating node
     call new_probe(c, 0._dp, probe)
     call contact_update(probe, model, q, .true., added, .false.)
-    free_pen = 0
+    free_pen = 0; node = 0
     do k = 1, probe%set%nact
       if (holds(c%set, probe%set%act(k)%node, probe%set%act(k)%pair)) cycle
-      free_pen = max(free_pen, -probe%set%act(k)%gap)
+      if (-probe%set%act(k)%gap > free_pen) then
+        free_pen = -probe%set%act(k)%gap; node = probe%set%act(k)%node
+      end if
     end do
-    if (c%set%nact > 0) free_pen = max(free_pen, -minval(c%set%act(1:c%set%nact)%hold))   ! (held, not pushed out)
+    do k = 1, c%set%nact   ! (held, not pushed out)
+      if (-c%set%act(k)%hold > free_pen) then
+        free_pen = -c%set%act(k)%hold; node = c%set%act(k)%node
+      end if
+    end do
+    if (present(deepest)) deepest = node
     max_gap = 0
     if (c%set%nact > 0) max_gap = maxval(abs(c%set%act(1:c%set%nact)%gap))
   end subroutine contact_penetration

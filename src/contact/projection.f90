@@ -252,13 +252,24 @@ contains
     !> tangents (the first kept from the last, turned across n) and the relative tangential
     !> displacement of the node over the step
     subroutine friction_geometry()
-      real(dp) :: u(3), t1(3)
+      real(dp) :: u(3), t1(3), e(3)
       integer :: jj, nd
       if (con%grip == 0) return
       t1 = con%t(:, 1) - dot_product(con%t(:, 1), con%n)*con%n
       if (norm2(t1) < 0.5_dp) then   ! (a new constraint: any direction across n)
         t1 = [con%n(2), -con%n(1), 0._dp]
         if (norm2(t1) < 0.5_dp) t1 = [0._dp, con%n(3), -con%n(2)]
+        ! a node restrained along an axis in its tangent plane (a symmetry plane through the
+        ! contact): that axis first, so that its stick row is the restraint's alone and left
+        ! out (contact_rows), not half of two rows that the restraint makes dependent
+        do jj = 1, 3
+          if (.not. model%fixed(dof(con%node, jj))) cycle
+          e = 0; e(jj) = 1
+          e = e - dot_product(e, con%n)*con%n
+          if (norm2(e) > 0.99_dp) then
+            t1 = e; exit
+          end if
+        end do
       end if
       con%t(:, 1) = t1/norm2(t1)
       con%t(:, 2) = cross(con%n, con%t(:, 1))
@@ -531,7 +542,7 @@ contains
   !> The gradient lg(:, 1:nl) of dv . con%n on the positions of the nodes lnode(1:nl) that
   !> the target normal at con%xi depends on (con%side and xi held): the element's nodes, and
   !> with nodal normals those of every element at them. Reverse mode through
-  !> n = u/|u|, u = sum_j N_j m_j/|m_j|, m_j = sum_e s_e t_e/|t_e|, t_e = a1 x a2 (the cubic
+  !> n = u/|u|, u = sum_j N_j m_j/|m_j|, m_j = sum_e t_e/|t_e|, t_e = a1 x a2 (the cubic
   !> normal of element e at node j), gathered element by element. nl = 0 when the nodes
   !> outnumber max_lever (or the elements max_elem).
   subroutine normal_lever(c, model, x, con, dv, nl, lnode, lg, normals)
@@ -544,33 +555,26 @@ contains
     type(normal_cache_t), intent(inout), optional :: normals   !< made by constraint_geometry
     integer, parameter :: max_elem = 64
     real(dp) :: shp(10), dphi(10, 2), u(3), bu(3), m(3, 10), bm(3), t(3), ge(3, 10, max_elem)
-    integer :: j, i, nd, l, p, ne, el(max_elem), iv, nv
-    real(dp) :: sg(10*max_elem)   ! (each visit's sign, the forward's for the backward)
-    nl = 0; ne = 0; iv = 0
+    integer :: j, i, nd, l, p, ne, el(max_elem)
+    nl = 0; ne = 0
     call tri10_shape(con%xi(1), con%xi(2), shp, dphi)
     associate (g => c%geo)
       if (.not. c%opt%nodal_normal) then
-        call back_normal(con%elem, dphi, con%side*dv, 1._dp)
+        call back_normal(con%elem, dphi, con%side*dv)
       else
         u = 0
         do j = 1, 10   ! (forward, as constraint_geometry)
-          nd = model%conn(j, con%elem)
-          nv = g%node_start(nd + 1) - g%node_start(nd)
-          if (iv + nv > size(sg)) return
-          call node_normal_sum(c, model, x, con%elem, j, m(:, j), normals, sg(iv + 1:iv + nv))
-          iv = iv + nv
+          call node_normal_sum(c, model, x, con%elem, j, m(:, j), normals)
           u = u + (shp(j)/norm2(m(:, j)))*m(:, j)
         end do
         bu = u/norm2(u)
         bu = con%side*(dv - dot_product(dv, bu)*bu)/norm2(u)
-        iv = 0
         do j = 1, 10
           nd = model%conn(j, con%elem)
           t(1) = norm2(m(:, j)); m(:, j) = m(:, j)/t(1)
           bm = shp(j)*(bu - dot_product(bu, m(:, j))*m(:, j))/t(1)
           do i = g%node_start(nd), g%node_start(nd + 1) - 1
-            iv = iv + 1
-            call back_normal(g%node_elem(i), g%dphi_node(:, :, g%node_loc(i)), bm, sg(iv))
+            call back_normal(g%node_elem(i), g%dphi_node(:, :, g%node_loc(i)), bm)
           end do
         end do
       end if
@@ -590,11 +594,11 @@ contains
       end do
     end do
   contains
-    !> add the gradient of b . s t/|t| (t element e's cubic normal where its shape
+    !> add the gradient of b . t/|t| (t element e's cubic normal where its shape
     !> derivatives are ds) on e's nodes
-    subroutine back_normal(e, ds, b, s)
+    subroutine back_normal(e, ds, b)
       integer, intent(in) :: e
-      real(dp), intent(in) :: ds(10, 2), b(3), s
+      real(dp), intent(in) :: ds(10, 2), b(3)
       real(dp) :: a1(3), a2(3), tn(3), tl, bt(3), b1(3), b2(3)
       integer :: k, q
       if (ne > max_elem) return
@@ -606,7 +610,7 @@ contains
       end if
       a1 = matmul(x(:, model%conn(:, e)), ds(:, 1)); a2 = matmul(x(:, model%conn(:, e)), ds(:, 2))
       tn = cross(a1, a2); tl = norm2(tn); tn = tn/tl
-      bt = s*(b - dot_product(b, tn)*tn)/tl
+      bt = (b - dot_product(b, tn)*tn)/tl
       b1 = cross(a2, bt); b2 = cross(bt, a1)   ! b . (da1 x a2 + a1 x da2)
       do k = 1, 10
         ge(:, k, q) = ge(:, k, q) + ds(k, 1)*b1 + ds(k, 2)*b2
@@ -634,27 +638,24 @@ contains
     end if
   end function element_normal
 
-  !> m: the sum of the unit normals, at element e's node k, of every element there, each
-  !> turned to e's side (the nodal normal's direction); sg: their signs, in that order
-  !> (normal_lever's backward pass takes the same)
-  subroutine node_normal_sum(c, model, x, e, k, m, normals, sg)
+  !> m: the sum of the unit normals, at element e's node k, of every element there (the
+  !> nodal normal's direction). The mesh's orientation is consistent (scene.f90 refuses one
+  !> that is not), so each is taken as it is, as the fibres' sum at the start is (model.f90):
+  !> each turned to e's side by the sign of its dot product with e's, the sides of a square
+  !> tube's 90-degree crease were turned either way by round-off, and the normal there lay
+  !> along the wall (a can's node 2.6 mm off the crease was taken as touching: Newton failed)
+  subroutine node_normal_sum(c, model, x, e, k, m, normals)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: x(:, :)
     integer, intent(in) :: e, k
     real(dp), intent(out) :: m(3)
     type(normal_cache_t), intent(inout), optional :: normals
-    real(dp), intent(out), optional :: sg(:)
-    real(dp) :: own(3), t(3), s
     integer :: i, nd
     nd = model%conn(k, e)
-    own = element_normal(c, model, x, e, k, normals)
     m = 0
     do i = c%geo%node_start(nd), c%geo%node_start(nd + 1) - 1
-      t = element_normal(c, model, x, c%geo%node_elem(i), c%geo%node_loc(i), normals)
-      s = sign(1._dp, dot_product(t, own))
-      m = m + s*t
-      if (present(sg)) sg(i - c%geo%node_start(nd) + 1) = s
+      m = m + element_normal(c, model, x, c%geo%node_elem(i), c%geo%node_loc(i), normals)
     end do
   end subroutine node_normal_sum
 

@@ -189,10 +189,14 @@ contains
             mu = sliding_coefficient(c, a); key(1, r) = 4*a%node + 3
             call constraint_row(a, model, d, vs, ns, 3, force=.true.)   ! (the same points first)
           end if
-          w = 1   ! (the row's weight: 0 for an empty row across a held s)
+          w = 1   ! (the row's weight: 0 for an empty row across a held s, or a stick row held by restraints)
           if (kind == across) then
             ks = slip_stiffness(c, a)
             if (.not. ks > 0) w = 0
+          else if (kind /= 0) then   ! (its multiplier stays 0: the restraint's reaction holds it)
+            if (all(eq(d(1:nd)) == 0 .or. abs(v(1:nd)) <= 1e-12_dp*maxval(abs(v(1:nd))))) then
+              w = 0; gap(r) = 0
+            end if
           end if
           do j = 1, nd
             if (eq(d(j)) == 0) cycle   ! prescribed parameter: no column
@@ -201,6 +205,7 @@ contains
           end do
           m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
           if (kind == 0) val(m) = -normal_compliance(c, a)
+          if (kind /= 0 .and. kind /= across .and. w == 0) val(m) = -1
           if (kind == across) then
             val(m) = -1
             if (w > 0) val(m) = -1/ks

@@ -136,7 +136,7 @@ contains
               tn = -1
               reach = huge(1._dp)   ! (2 vmax tmax would overflow without a horizon)
               if (present(horizon)) reach = 2*vmax*tmax + model%body(bi)%thickness + model%body(bt)%thickness
-              if (bi /= bt .and. best <= reach) tn = ray_time(c, model, s, x, g(:, n), v(:, n), vm, gm, &
+              if (bi /= bt .and. best <= reach) tn = ray_time(c, model, s, x, g, v(:, n), vm, gm, &
                                                              bi, bt, n, lo, hi, vmax, tmax)
               if (rounded) then   ! (edge-on: the path need not meet a face)
                 tl = closing_time(gap, speed, vmax)
@@ -173,20 +173,21 @@ contains
     if (speed > 1e-12_dp*vmax) t = max(gap, 0._dp)/speed
   end function closing_time
 
-  !> The earliest time at which node n of body bi (fibre gn, velocity vn), moving straight on
-  !> relative to each sub-triangle of surface s (at its nodes' mean velocity vm; fibre gm),
-  !> comes within both faces' offset of that sub-triangle's plane with its foot inside it; -1
-  !> if never or after tmax. lo, hi: the sub-triangles' boxes, which a path that cannot reach
-  !> them within the best time skips.
-  real(dp) function ray_time(c, model, s, x, gn, vn, vm, gm, bi, bt, n, lo, hi, vmax, tmax) result(t)
+  !> The earliest time at which node n of body bi (fibres g, velocity vn), moving straight on
+  !> relative to each sub-triangle of surface s (at its nodes' mean velocity vm; mean fibre
+  !> gm), comes within both faces' offset of that sub-triangle's plane with its foot inside
+  !> it, or, aimed at its edge, of the triangle itself; -1 if never or after tmax. lo, hi: the
+  !> sub-triangles' boxes, which a path that cannot reach them within the best time skips.
+  real(dp) function ray_time(c, model, s, x, g, vn, vm, gm, bi, bt, n, lo, hi, vmax, tmax) result(t)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     type(surface_t), intent(in) :: s
-    real(dp), intent(in) :: x(:, :), gn(3), vn(3), vm(:, :), gm(:, :), lo(:, :), hi(:, :), vmax, tmax
+    real(dp), intent(in) :: x(:, :), g(:, :), vn(3), vm(:, :), gm(:, :), lo(:, :), hi(:, :), vmax, tmax
     integer, intent(in) :: bi, bt, n
-    real(dp) :: w(3), a(3), e1(3), e2(3), nt(3), sd, side, off, th, tc, p(3), q(3), bary(3), grow
+    real(dp) :: w(3), a(3), e1(3), e2(3), nt(3), sd, side, off, th, tc, p(3), q(3), bary(3), grow, gn(3)
     integer :: it, region
     logical :: found
+    gn = g(:, n)
     found = .false.
     t = tmax
     grow = 0
@@ -216,21 +217,24 @@ contains
         ! distance to the triangle is off, before it crosses the plane. w's part along the
         ! plane bounds how fast the foot can come back.)
         tc = abs(sd)/(-side*dot_product(w, nt))
-        if (norm2(q - p) - norm2(w - dot_product(w, nt)*nt)*(tc - th) > off) cycle
-        th = offset_time(x(:, n), w, a, e1, e2, off, th, min(tc, t))
+        if (norm2(q - p) - norm2(w - dot_product(w, nt)*nt)*(tc - th) > max(off, grow)) cycle
+        th = offset_time(th, min(tc, t))
         if (th < 0) cycle
       end if
       t = th; found = .true.
     end do
     if (.not. found) t = -1
-  end function ray_time
+  contains
 
-  !> The first time in [t0, t1] at which the path x + w t comes within off of the triangle
-  !> (a, a + e1, a + e2), whose distance exceeds off at t0; -1 if it does not. The distance to
-  !> a triangle is convex along a line: golden sections close in on its least value until one
-  !> is within off, and bisection finds the first time between.
-  real(dp) function offset_time(x, w, a, e1, e2, off, t0, t1) result(t)
-    real(dp), intent(in) :: x(3), w(3), a(3), e1(3), e2(3), off, t0, t1
+  !> The first time in [t0, t1] at which node n's path comes within both faces' offset of
+  !> sub-triangle it (a, a + e1, a + e2), each along the line from the triangle's nearest
+  !> point to the path, with the target's fibre there (at a crease's edge the plane's normal
+  !> gave the fibres' offsets a third less: a ball's node aimed at a prism's 60-degree crease
+  !> was said 5.62e-4 s for a touch at 4.79e-4 s); -1 if it does not. The distance to a
+  !> triangle is convex along a line, and its offset changes slowly: golden sections close
+  !> in on the least excess until one is within, and bisection finds the first time between.
+  real(dp) function offset_time(t0, t1) result(t)
+    real(dp), intent(in) :: t0, t1
     real(dp), parameter :: golden = 0.6180339887498949_dp
     real(dp) :: lo, hi, m1, m2, f1, f2, tp
     integer :: k
@@ -264,15 +268,20 @@ contains
       end if
     end do
     t = hi
-  contains
-    real(dp) function excess(s)
-      real(dp), intent(in) :: s
-      real(dp) :: q(3), bary(3)
-      integer :: region
-      call closest_point_triangle(x + s*w, a, a + e1, a + e2, q, bary, region)
-      excess = norm2(x + s*w - q) - off
-    end function excess
   end function offset_time
+
+  real(dp) function excess(tau)
+    real(dp), intent(in) :: tau
+    real(dp) :: y(3), q(3), bary(3), u(3), d
+    integer :: region
+    y = x(:, n) + tau*w
+    call closest_point_triangle(y, a, a + e1, a + e2, q, bary, region)
+    d = norm2(y - q)
+    u = nt
+    if (d > 0) u = (y - q)/d
+    excess = d - face_along(c, model, bi, gn, -u) - face_along(c, model, bt, matmul(g(:, s%tri(:, it)), bary), u)
+  end function excess
+  end function ray_time
 
   !> the path x + w t, 0 <= t <= tmax, meets the box [lo, hi] (slabs)
   pure logical function path_meets_box(x, w, tmax, lo, hi) result(meets)

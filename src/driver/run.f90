@@ -1,5 +1,6 @@
 !> The commands that work on a deck: `check` (read, sanity, build) and `run` (the time loop:
-!> step, account, write). Exit codes: 0 done, 2 bad input, 3 the solver could not go on.
+!> step, account, write; the run's state is casca_run_state's run_t, its warnings
+!> casca_run_watch's). Exit codes: 0 done, 2 bad input, 3 the solver could not go on.
 module casca_run
   use, intrinsic :: iso_fortran_env, only: output_unit
   use casca_kinds, only: dp, pi
@@ -7,21 +8,19 @@ module casca_run
   use casca_deck, only: deck_t, read_deck, unset, add_problem, default_newton_tol
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
-  use casca_starter, only: put_warnings, contact_time, spring_time, static_warnings
-  use casca_model, only: model_t, reference_state, dof, thinnest, least_face_stretch
-  use casca_assembly, only: assembly_t, assembly_setup
-  use casca_linear_system, only: linear_system_t
+  use casca_starter, only: put_warnings, spring_time, deck_warnings
+  use casca_model, only: model_t, reference_state, dof
+  use casca_assembly, only: assembly_setup
   use casca_mass_solver, only: mass_setup
   use casca_start_acceleration, only: loaded_acceleration
-  use casca_newton, only: newton_opts_t, newton_report_t
   use casca_newmark, only: state_t, newmark_step
   use casca_statics, only: static_solve
-  use casca_time_scheme, only: scheme_t, newmark_scheme, alpha_scheme
-  use casca_step_control, only: step_control_t, local_error, depth_error, energy_error, next_step_ratio
+  use casca_time_scheme, only: newmark_scheme, alpha_scheme
+  use casca_step_control, only: local_error, depth_error, energy_error, next_step_ratio
   use casca_step_size, only: time_to_contact
-  use casca_accounting, only: balance_t, energy_term_t, account, gravity_load, balance_summary, &
+  use casca_accounting, only: balance_t, account, gravity_load, balance_summary, &
                               energy_balance, balance_remainder
-  use casca_output, only: output_t, output_open, output_history, output_frame, output_close, output_mark_stopped, &
+  use casca_output, only: output_open, output_history, output_frame, output_close, output_mark_stopped, &
                           output_flush, output_release, output_indicator_lines
   use casca_vtu_writer, only: field_t, field
   use casca_mesh_indicator, only: indicator_line_len
@@ -39,84 +38,15 @@ module casca_run
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
   use casca_obstacle, only: obstacle_point
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
-  use casca_strings, only: count_of, rtoa, vtoa, ftoa, itoa
+  use casca_strings, only: count_of, rtoa, ftoa, itoa
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
+  use casca_run_state, only: run_t, progress_t, exit_ok, exit_input, exit_solver, exit_signal, cap_hold, &
+                             newton_share, newton_floor
+  use casca_run_watch, only: watch_energy, watch_thickness, watch_faces, squeezed, squeeze_note, rest_now, &
+                             step_judged, warn_dynamic, balance_terms, moving_obstacles
   implicit none
   private
-  public :: load_scene, run_deck
-
-  integer, parameter, public :: exit_ok = 0, exit_input = 2, exit_solver = 3, exit_signal = 4
-  !> with an error-controlled step: the energy's cap (run_t%dt_cap) doubles after this many of
-  !> its lengths
-  real(dp), parameter :: cap_hold = 20
-  !> under &run tolerance, Newton's tolerance is at most this share of the error asked for,
-  !> and not below newton_floor (of the scene size: round-off's reach)
-  real(dp), parameter :: newton_share = 1e-5_dp, newton_floor = 1e-12_dp
-  !> Saint-Venant-Kirchhoff's least thickness stretch: its uniaxial compressive stress,
-  !> E lambda (lambda^2 - 1)/2, is largest at lambda = 1/sqrt(3) (squeezed)
-  real(dp), parameter :: svk_limit = 1/sqrt(3._dp)
-
-  type :: least_t   !< the least of a stretch over the run's states: where and when
-    real(dp) :: stretch = huge(1._dp), t = 0
-    integer :: node = 0
-    real(dp) :: t_past = -1   !< when it first went below svk_limit (-1: never)
-  end type least_t
-
-  type :: progress_t   !< where the last progress line was
-    real(dp) :: wall = 0, t = 0
-    integer :: step = 0, newton = 0
-  end type progress_t
-
-  !> One run of a deck: what it builds and what it carries from step to step
-  type :: run_t
-    type(deck_t) :: deck
-    type(model_t) :: model
-    type(assembly_t) :: asm
-    type(linear_system_t), allocatable :: ls
-    type(newton_opts_t) :: opts
-    type(newton_report_t) :: rep
-    type(state_t) :: st
-    type(scheme_t) :: nm                        !< the time integration scheme
-    type(step_control_t) :: sc                  !< steps by an error estimate (tol > 0)
-    real(dp) :: dt_try = 0                      !< with sc: the next step's length
-    logical :: onset = .false.                  !< with sc: a contact begins at this step's end or start
-    !> with sc: a step this long made too much energy with no contact active; shorter ones
-    !> until a contact is active, the cap doubling after cap_hold of its lengths (in the
-    !> checkpoint, with cap_since)
-    real(dp) :: dt_cap = huge(1._dp)
-    real(dp) :: cap_since = 0                   !< when dt_cap was set or last doubled
-    !> the energy the last free step made (energy_accepted): a step may make back what the
-    !> one before removed
-    real(dp) :: made_last = 0
-    logical :: floor_told = .false.             !< with sc: a step kept above the tolerance was told
-    type(balance_t) :: bal, bal0                !< now, and at the start of the run
-    !> the energy a step made (the remainder of the balance fell): the largest, when, and the
-    !> contacts then; a run from t = 0 warns of it at its end (watch_energy)
-    real(dp) :: rest_last = 0, made_max = 0, t_made = 0, dt_made = 0
-    real(dp) :: dt_made_before = 0              !< the free step before it, when shorter (grown back)
-    real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
-    integer :: made_contacts = 0
-    integer :: made_between = 0                 !< of them, between bodies (not obstacles)
-    !> a body under gravity starts held by its contact (a = 0): its first step makes energy
-    !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact: not watched
-    logical :: held_at_start = .false.
-    !> the least stretches the run's states reached, through the thickness and along the
-    !> faces, where and when (watch_thickness, watch_faces)
-    type(least_t) :: thick, face
-    type(output_t) :: out
-    type(contact_t), allocatable :: contact     !< not allocated: no contact (absent below)
-    type(error_t), allocatable :: err
-    real(dp), allocatable :: fext(:), q0(:)     !< dead loads with gravity; reference state
-    logical, allocatable :: frozen(:), idle(:)  !< idle bodies, left out of the equations
-    integer, allocatable :: tracked(:)
-    character(len=128), allocatable :: labels(:)
-    character(len=:), allocatable :: dir, restart
-    real(dp) :: t0 = 0                          !< wall time at the start
-    integer :: level = 0                        !< step cuts: dt / 2**level
-    integer :: restart_step = -1, total_newton = 0, code = exit_ok
-    logical :: quiet = .false.
-    type(progress_t) :: last
-  end type run_t
+  public :: load_scene, run_deck, exit_ok, exit_input
 
 contains
 
@@ -281,7 +211,7 @@ contains
       r%fext = r%fext + model%fext
       call tracked_nodes(deck, model, r%tracked, far)
       if (is_root()) call put_warnings(far, 0)
-      if (is_root()) call put_warnings(static_warnings(deck), 0)
+      if (is_root()) call put_warnings(deck_warnings(deck), 0)
       allocate (r%labels(size(r%tracked)))
       do k = 1, size(r%tracked)
         associate (b => model%body(model%node_body(r%tracked(k))))
@@ -359,6 +289,13 @@ contains
             deallocate (r%err)
             cycle
           end if
+          if (r%onset .and. .not. r%over_onset) then
+            ! (a thin hoop hopping on a floor under a tolerance: a 5.1 us step up to a node's
+            ! landing failed and could not be halved at 0.187 s; steps over it went on)
+            r%over_onset = .true.
+            deallocate (r%err)
+            cycle
+          end if
           call give_up(r, r%err%message)
           return
         end if
@@ -393,7 +330,7 @@ contains
           energy_cut = .true.
           cycle
         end if
-        energy_cut = .false.
+        energy_cut = .false.; r%over_onset = .false.
         r%ls%saddle_steps = max(r%ls%saddle_steps - 1, 0)
         r%total_newton = r%total_newton + rep%iters
         if (r%sc%tol > 0) then
@@ -571,6 +508,13 @@ contains
       next_ckpt = huge(1._dp)
       if (deck%output%checkpoint_interval > 0) &
         next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
+      if (st%step == 0) then   ! (the unloaded state, as a dynamic run's t = 0: frames and plots start undeformed)
+        call account_state(r, factor=0._dp)
+        call history_row(r, 0)
+        if (failed(r, 'history')) return
+        call frame(r)
+        if (failed(r, 'frame')) return
+      end if
       do i = st%step + 1, deck%run%load_steps
         call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/deck%run%load_steps, &
                           deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, stabilised, r%contact)
@@ -632,7 +576,7 @@ contains
         ! stop the node within it (a force m v / sliver), but the deck's dt from here
         h = min(h, level(r%deck%run%dt))
         r%onset = .true.
-      else if (hit < h) then
+      else if (hit < h .and. .not. r%over_onset) then
         h = hit
         r%onset = .true.
       end if
@@ -691,9 +635,9 @@ contains
       ! (once, and clearly above: the answer is then the shortest step's, not the tolerance's)
       r%floor_told = .true.
       if (is_root()) write (0, '(a)') 'warning: the step of '//rtoa(h)//' s to t = '//rtoa(r%st%t)// &
-        ' s is '//rtoa(err)//' times the tolerance, at or below the shortest step allowed, dt / '// &
-        '2^max_step_cuts = '//rtoa(r%sc%dt_min)//' s, and was kept: the tolerance is not met there; give a shorter '// &
-        'dt or a larger max_step_cuts (&run) for it'
+        ' s is '//rtoa(err)//' times the tolerance, at the shortest step allowed (the output interval '// &
+        'halved until it is at most dt / 2^max_step_cuts = '//rtoa(r%sc%dt_min)//' s), and was kept: the '// &
+        'tolerance is not met there; give a shorter dt or a larger max_step_cuts (&run) for it'
     end if
     if (ok .and. ratio >= 1) then   ! (a step cut short by a frame or the grid does not shorten it)
       r%dt_try = max(r%dt_try, h*ratio)
@@ -999,10 +943,14 @@ contains
     type(run_t), intent(inout) :: r
     integer, intent(in) :: newton
     real(dp) :: lmax, pen, gmax
+    integer :: node
     pen = 0; gmax = 0; lmax = 0
     if (allocated(r%contact)) then
       associate (c => r%contact)
-        call contact_penetration(c, r%model, r%st%q, pen, gmax)
+        call contact_penetration(c, r%model, r%st%q, pen, gmax, node)
+        if (pen > r%sink) then
+          r%sink = pen; r%sink_node = node; r%t_sink = r%st%t
+        end if
         if (c%set%nact > 0) lmax = maxval(c%set%act(1:c%set%nact)%lambda)
         call output_history(r%out, r%st, r%bal, c%set%nact, contact_force_total(c), newton, &
                             max(pen, 0._dp), r%rep%neg_pivots, lmax, gmax, &
@@ -1109,6 +1057,11 @@ contains
       write (0, '(a)') 'hint: the Schur complement C K^-1 C^T fails where the stiffness K is '// &
         'near-singular in directions the contacts hold (a buckled shell); solver = ''saddle'' '// &
         '(&contact) factorises the whole saddle-point matrix, which is regular there'
+    else if (is_root() .and. index(reason, 'static Newton did not converge') > 0 .and. &
+             index(reason, 'no equilibrium') == 0) then
+      write (0, '(a)') 'hint: more load_steps (&run, now '//itoa(r%deck%run%load_steps)//') start '// &
+        'from smaller increments, and a larger max_step_cuts (now '//itoa(r%deck%run%max_step_cuts)// &
+        ') lets a load step be halved more often'
     else if (is_root() .and. r%nm%gamma <= 0.5_dp .and. r%deck%run%analysis /= 'static') then
       write (0, '(a)') 'hint: '//r%nm%describe()//' keeps the shells'' fastest vibrations '// &
         'undamped, which can stall Newton; rho_inf = 0.8 (generalized-alpha) damps them, '// &
@@ -1186,7 +1139,7 @@ contains
       r%code = exit_solver; return
     end if
     if (r%deck%output%plots .and. is_root()) then
-      call make_plots(r%dir, e, missing)
+      call make_plots(r%dir, e, missing, static=r%deck%run%analysis == 'static')
       if (allocated(e)) write (0, '(a,a)') 'warning: plots: ', e%message
       if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//r%dir// &
         '/plots.gp was written but not run'
@@ -1212,106 +1165,6 @@ contains
       print '(a)', (trim(lines(k)), k=1, size(lines))
     end associate
   end subroutine finish
-  !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
-  !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
-  !> and it may only grow with a dissipative scheme (stay, with a conservative one)
-  subroutine watch_energy(r, rest, start, h_before)
-    type(run_t), intent(inout) :: r
-    real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
-    type(contact_t), intent(in), optional :: start   !< the contact at the step's start
-    real(dp), intent(in), optional :: h_before   !< the step before's length if it was free, else 0
-    if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
-      r%made_max = r%rest_last - rest; r%t_made = r%st%t; r%dt_made = r%nm%dt
-      r%dt_made_before = 0
-      if (present(h_before) .and. r%sc%tol <= 0) then   ! (fixed steps, grown back after cuts)
-        if (h_before > 0 .and. r%nm%dt > 1.5_dp*h_before) r%dt_made_before = h_before
-      end if
-      r%made_contacts = 0; r%made_between = 0   ! (those of a step that released them acted in it too)
-      if (allocated(r%contact)) call count_active(r%contact)
-      if (present(start)) call count_active(start)
-    end if
-    r%rest_last = rest
-    r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
-  contains
-    subroutine count_active(c)
-      type(contact_t), intent(in) :: c
-      r%made_contacts = max(r%made_contacts, c%set%nact)
-      r%made_between = max(r%made_between, count(c%pair(2, c%set%act(1:c%set%nact)%pair) > 0))
-    end subroutine count_active
-  end subroutine watch_energy
-
-  !> Keep the least thickness stretch of the run's states (thinnest; every step)
-  subroutine watch_thickness(r)
-    type(run_t), intent(inout) :: r
-    real(dp) :: stretch
-    integer :: node
-    call thinnest(r%model, r%st%q, node, stretch)
-    call keep_least(r%thick, stretch, node, r%st%t)
-  end subroutine watch_thickness
-
-  !> Keep the least stretch along the faces (least_face_stretch): at the frames' times and where
-  !> the run ends or stops, as it costs about 0.6 us an element, 1.5% of a step of the three
-  !> spheres
-  subroutine watch_faces(r)
-    type(run_t), intent(inout) :: r
-    real(dp) :: stretch
-    integer :: node
-    if (.not. (allocated(r%model%face_metric) .and. allocated(r%st%q))) return   ! (stopped before)
-    call least_face_stretch(r%model, r%st%q, node, stretch)
-    call keep_least(r%face, stretch, node, r%st%t)
-  end subroutine watch_faces
-
-  pure subroutine keep_least(least, stretch, node, t)
-    type(least_t), intent(inout) :: least
-    real(dp), intent(in) :: stretch, t
-    integer, intent(in) :: node
-    if (stretch < svk_limit .and. least%t_past < 0) least%t_past = t
-    if (stretch < least%stretch) least = least_t(stretch, t, node, least%t_past)
-  end subroutine keep_least
-
-  !> A shell squeezed past Saint-Venant-Kirchhoff's limit (svk_limit), through its thickness
-  !> or along a face: squeezed further its stress falls, so the equations lose their solution
-  !> there (a rubber ring thrown at a floor at 15 m/s reached 0.2 through its thickness, a
-  !> ring crushed flat folded to 0.4 along its inner face; Newton stalled)
-  logical function squeezed(r)
-    type(run_t), intent(in) :: r
-    squeezed = min(r%thick%stretch, r%face%stretch) < svk_limit
-  end function squeezed
-
-  function squeeze_note(r) result(msg)
-    type(run_t), intent(in) :: r
-    character(len=:), allocatable :: msg
-    msg = ''
-    if (r%thick%stretch < svk_limit) then
-      if (r%thick%stretch <= 0) then
-        msg = at(r%thick, 'turned inside out through its thickness')
-      else
-        msg = at(r%thick, 'squeezed through its thickness to '//itoa(nint(100*r%thick%stretch))//'%')
-      end if
-    end if
-    if (r%face%stretch < svk_limit) then
-      if (len(msg) > 0) msg = msg//', and '
-      msg = msg//at(r%face, 'compressed along its face to '//itoa(nint(100*r%face%stretch))// &
-            '% (folded or bent tighter than its thickness allows)')
-    end if
-    msg = msg//'; the Saint-Venant-Kirchhoff material holds to '//itoa(nint(100*svk_limit))// &
-          '% only (squeezed further, its stress falls): the results there are beyond the material law'
-    if (r%thick%stretch < svk_limit) msg = msg//' (a slower impact, or a thicker or stiffer shell, stays within it)'
-  contains
-    function at(least, how) result(s)
-      type(least_t), intent(in) :: least
-      character(len=*), intent(in) :: how
-      character(len=:), allocatable :: s
-      integer :: b
-      b = r%model%node_body(least%node)
-      s = 'body '''//r%model%body(b)%name//''' was '//how//' at its node '// &
-          itoa(least%node - r%model%body(b)%node_first + 1)//' (at '// &
-          vtoa(r%model%x0(:, least%node))//' at the start) at t = '//rtoa(least%t)//' s'
-      if (least%t_past < least%t) s = s//' (below '//itoa(nint(100*svk_limit))//'% from t = '// &
-                                      rtoa(least%t_past)//' s)'
-    end function at
-  end function squeeze_note
-
   !> The run's energies and momenta now (accounting.f90); the total holds a compliant contact's
   !> energy too, as a spring's (the balance's remainder counts it as a term of its own)
   subroutine account_state(r, factor)
@@ -1324,150 +1177,4 @@ contains
     end if
     if (allocated(r%contact)) r%bal%total = r%bal%total + sum(pair_stored_energy(r%contact))
   end subroutine account_state
-
-  !> energy_balance's remainder at the run's state: E0 less what the bodies hold and the
-  !> terms taken out (what the integrator and the contact removed so far)
-  real(dp) function rest_now(r)
-    type(run_t), intent(in) :: r
-    rest_now = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact))
-  end function rest_now
-
-  !> Whether the step just taken is judged for the energy it made: not the first of a start
-  !> held by its contact (held_at_start)
-  logical function step_judged(r)
-    type(run_t), intent(in) :: r
-    step_judged = r%st%step > merge(1, 0, r%held_at_start)
-  end function step_judged
-
-  !> What a dynamic run warns of at its end or stop (rank 0): energy made, Coulomb's bound
-  subroutine warn_dynamic(r)
-    type(run_t), intent(in) :: r
-    if (.not. is_root() .or. r%deck%run%analysis == 'static') return
-    call warn_energy(r)
-    call warn_coulomb(r)
-  end subroutine warn_dynamic
-
-  !> Coulomb's bound over the run, where it can be read from the impulse column: a pair with a
-  !> plane obstacle (one normal) takes at most mu times its normal impulse along the plane. The
-  !> trapezoidal rule's contact forces ring, and the friction of a hoop hopping on a floor came
-  !> to 0.56 of its normal impulse at mu 0.3 (the acceleration's projection moves the normal
-  !> share of the step's start, not the friction's: docs/performance.md)
-  subroutine warn_coulomb(r)
-    type(run_t), intent(in) :: r
-    real(dp) :: jn, jt, mu
-    integer :: p
-    if (.not. allocated(r%contact)) return
-    associate (c => r%contact)
-      do p = 1, c%npairs
-        if (c%pair(2, p) >= 0) cycle
-        if (c%obstacle(-c%pair(2, p))%shape /= 'plane') cycle
-        mu = max(c%mu_d(p), c%mu_s(p))
-        if (mu <= 0) cycle
-        jn = dot_product(c%impulse(:, p), c%obstacle(-c%pair(2, p))%normal)
-        jt = norm2(c%impulse(:, p) - jn*c%obstacle(-c%pair(2, p))%normal)
-        if (jn <= 0 .or. jt <= 1.02_dp*mu*jn) cycle
-        write (0, '(a)') 'warning: pair '''//trim(r%model%body(c%pair(1, p))%name)//''' -> '''// &
-          trim(c%obstacle(-c%pair(2, p))%name)//''': its friction impulse is '//ftoa(jt/jn)// &
-          ' of its normal impulse, above its coefficient '//ftoa(mu)//' (Coulomb''s bound): '// &
-          'the contact forces rang from step to step'//trim(ringing())
-      end do
-    end associate
-  contains
-    function ringing() result(s)
-      character(len=:), allocatable :: s
-      s = '; a shorter dt brings it nearer'
-      if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) s = ' ('//r%nm%describe()//' keeps them '// &
-        'undamped: rho_inf = 0.8 (generalized-alpha) damps them)'
-    end function ringing
-  end subroutine warn_coulomb
-
-  !> A run from t = 0 whose step made more than 1e-3 of E0 says so: with contact active most
-  !> often the contact's doing; with none, the time scheme's, over a motion its steps do not
-  !> follow (the schemes keep or remove the energy of linear vibrations, not of every
-  !> nonlinear one)
-  subroutine warn_energy(r)
-    type(run_t), intent(in) :: r
-    character(len=:), allocatable :: made, why, shorter
-    real(dp) :: e0, tc
-    integer :: b
-    e0 = abs(r%bal0%total)
-    if (r%restart_step >= 0 .or. .not. r%made_max > 1e-3_dp*max(e0, r%e_scale)) return
-    if (e0 >= 1e-3_dp*r%e_scale) then
-      made = ftoa(100*r%made_max/e0)//'% of the initial energy'
-    else   ! (a scene that starts at rest under its loads)
-      made = rtoa(r%made_max)//' J (the bodies held at most '//rtoa(r%e_scale)//' J)'
-    end if
-    why = 'a node that came deep into a target in one step'
-    if (allocated(r%contact) .and. r%made_between > 0) then   ! (closed shells have no rim)
-      if (any(r%contact%rim)) why = 'a shell''s edge that passed between the other''s nodes (casca has '// &
-                                    'no edge-to-edge contact; with one pass, test the edge''s body as impactor or '// &
-                                    'set passes = 2), or a node that came deep into a target in one step'
-    end if
-    ! (under a tolerance the steps in contact are the error estimate's, which leaves the
-    ! contact nodes out: two balls head-on made 0.24% in a 100 us step at 1e-3)
-    shorter = 'a shorter dt'
-    if (r%sc%tol > 0) shorter = 'a smaller tolerance'
-    why = why//'; look at the frames there, or take '//shorter
-    ! (an 80-degree plate landing edge-first under the trapezoidal rule: 0.72% of E0, the same
-    ! between mid-surfaces, no node edge-on or deep)
-    if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) why = why//'; or the impact''s ringing, '// &
-      'which '//r%nm%describe()//' keeps undamped: rho_inf = 0.8 (generalized-alpha) damps it'
-    if (r%made_contacts == 0 .and. r%dt_made_before > 0) then
-      ! (a hoop hopping on a floor, its steps halved to 0.25 ms: 0.23% in the step that grew
-      ! back to 0.5 ms, its strain energy alternating for ten steps after)
-      why = 'with no contact, in a step that had grown back to '//rtoa(r%dt_made)//' s after cuts to '// &
-            rtoa(r%dt_made_before)//' s: the start acceleration of the shorter steps rang in the longer '// &
-            'one; take a shorter dt (the cuts say how much shorter), or give a tolerance (&run)'
-    else if (r%made_contacts == 0) then
-      why = 'with no contact, the time scheme made it over a motion its steps do not follow, '// &
-            'as a spinning thin shell''s breathing under steps longer than its period (a stiff '// &
-            'shell holds much energy in a small error); '
-      if (r%sc%tol > 0) then   ! (with moving obstacles or pressures: not bounded step by step)
-        why = why//'take a smaller tolerance'
-      else
-        why = why//'take a shorter dt, or give a tolerance (&run), which also bounds the '// &
-              'energy a step makes while no contact is active'
-      end if
-    else if (allocated(r%contact)) then
-      if (r%contact%opt%compliant) then   ! (a spring whose steps are too long for it)
-        tc = contact_time(r%deck, r%model, b)
-        why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &
-              rtoa(tc/r%dt_made)//' steps of that step ('//rtoa(r%dt_made)//' s) for body '''// &
-              trim(r%model%body(b)%name)//'''; take '//shorter//' or a lower stiffness'
-      end if
-    end if
-    write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
-      count_of(r%made_contacts, 'contact', 'contacts')//' active at its start or end: '//why
-  end subroutine warn_energy
-
-  !> The energy balance's terms that the scene has: friction's, moving obstacles', a
-  !> compliant contact's; with corrections, a hard contact's velocity corrections' (the
-  !> printed balance: a step's energy is judged with them in the remainder, as it was tuned)
-  function balance_terms(deck, contact, corrections) result(terms)
-    type(deck_t), intent(in) :: deck
-    type(contact_t), intent(in), optional :: contact
-    logical, intent(in), optional :: corrections
-    type(energy_term_t), allocatable :: terms(:)
-    allocate (terms(0))
-    if (.not. present(contact)) return
-    if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
-                                                             sum(contact%friction_work))]
-    if (moving_obstacles(deck, .true.)) &
-      terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work, &
-                                                          source=.true.)]
-    if (contact%opt%compliant) then
-      terms = [terms, energy_term_t('held in the contact stiffness', sum(pair_stored_energy(contact)))]
-    else if (present(corrections)) then
-      if (corrections) terms = [terms, energy_term_t('taken out by the velocity corrections', &
-                                                     sum(contact%correction_loss))]
-    end if
-  end function balance_terms
-
-  logical function moving_obstacles(deck, use_contact)
-    type(deck_t), intent(in) :: deck
-    logical, intent(in) :: use_contact
-    integer :: k
-    moving_obstacles = use_contact .and. any([(any(deck%obstacles(k)%velocity /= 0), &
-                                               k=1, size(deck%obstacles))])
-  end function moving_obstacles
 end module casca_run

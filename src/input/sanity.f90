@@ -421,7 +421,16 @@ contains
     function no_body(name) result(msg)
       character(len=*), intent(in) :: name
       character(len=:), allocatable :: msg
-      msg = ''''//trim(name)//''' is not a body of the deck'//did_you_mean(name, deck%bodies%name)
+      integer :: k
+      msg = ''''//trim(name)//''' is not a body of the deck'
+      do k = 1, size(deck%obstacles)   ! (an obstacle's pairs are its own &obstacle bodies)
+        if (deck%obstacles(k)%name == name) then
+          msg = msg//' but an &obstacle: it meets the bodies its &obstacle bodies lists (every '// &
+                'body when not given), not through &contact pairs'
+          return
+        end if
+      end do
+      msg = msg//did_you_mean(name, deck%bodies%name)
     end function no_body
 
     integer function find_body(name)

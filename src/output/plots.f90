@@ -7,8 +7,10 @@
 !> run folder without casca. Columns are looked up by name (not position), so extra columns
 !> added to history.dat later do not break the plots.
 !>
-!> Units are SI as the solver writes them (s, m, J, N); time is plotted in ms.
+!> Units are SI as the solver writes them (s, m, J, N); time is plotted in ms, and a static
+!> run's first column, its load factor, as it is.
 module casca_plots
+  use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_strings, only: itoa
   implicit none
@@ -38,16 +40,20 @@ contains
   !> Write DIR/plots.gp from the header of DIR/history.dat and run gnuplot on it in DIR.
   !> If gnuplot is not installed this is not an error: gnuplot_missing (if present) is set
   !> .true. and the script is left for the user. A failing gnuplot run is an error.
-  subroutine make_plots(dir, err, gnuplot_missing)
+  subroutine make_plots(dir, err, gnuplot_missing, static)
     character(len=*), intent(in) :: dir
     type(error_t), allocatable, intent(out) :: err
     logical, intent(out), optional :: gnuplot_missing
+    !> a static run (first column: the load factor); not given, one whose kinetic energy is
+    !> 0 in every row (casca plot DIR, which has the history alone)
+    logical, intent(in), optional :: static
 
     character(len=:), allocatable :: d, hist, script, cmd
     type(word_t), allocatable :: labels(:)
     integer :: col(nreq), nk, stat, cstat
     integer, allocatable :: pcol(:, :)
     character(len=msg_len) :: cmsg
+    logical :: by_load
 
     if (present(gnuplot_missing)) gnuplot_missing = .false.
     d = clean_dir(dir)
@@ -58,7 +64,12 @@ contains
     nk = size(pcol, 2)
     call read_labels(d//'/tracked.txt', nk, labels)
 
-    script = gnuplot_script(col, pcol, labels)
+    if (present(static)) then
+      by_load = static
+    else
+      by_load = at_rest(hist, col(3))
+    end if
+    script = gnuplot_script(col, pcol, labels, by_load)
     call write_text(d//'/plots.gp', script, err)
     if (allocated(err)) return
 
@@ -165,6 +176,32 @@ contains
     end if
   end subroutine read_header
 
+  !> Whether column c (the kinetic energy) of the history at path is 0 in every row
+  logical function at_rest(path, c)
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: c
+    character(len=:), allocatable :: line
+    type(word_t), allocatable :: w(:)
+    real(dp) :: x
+    integer :: u, ios
+    at_rest = .false.
+    open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios)
+    if (ios /= 0) return
+    call read_line(u, line, ios)   ! (the header)
+    do
+      call read_line(u, line, ios)
+      if (ios /= 0) exit
+      w = split(line)
+      if (size(w) < c) exit
+      read (w(c)%s, *, iostat=ios) x
+      if (ios /= 0 .or. x /= 0) then
+        close (u); return
+      end if
+      at_rest = .true.
+    end do
+    close (u)
+  end function at_rest
+
   !> Labels of the tracked nodes: line k of path (tracked.txt), or "node k" if the file or
   !> the line is missing or blank.
   subroutine read_labels(path, nk, labels)
@@ -197,16 +234,25 @@ contains
 
   !> The gnuplot script. Column numbers go in variables at the top so the plot commands read
   !> by name; the terminal falls back to libgd `png` where cairo is not built in.
-  function gnuplot_script(col, pcol, labels) result(s)
+  function gnuplot_script(col, pcol, labels, by_load) result(s)
     integer, intent(in) :: col(nreq), pcol(:, :)
     type(word_t), intent(in) :: labels(:)
+    logical, intent(in) :: by_load   !< a static run: against the load factor
     character(len=:), allocatable :: s
+    character(len=:), allocatable :: x_of, x_label, versus
 
     character(len=*), parameter :: axis(3) = ['x', 'y', 'z']
     character(len=:), allocatable :: v
     integer :: i, k, a, nk
 
     nk = size(pcol, 2)
+    if (by_load) then
+      x_of = 'ms(c) = column(c)   # a static run: the load factor as it is'
+      x_label = 'load factor [-]'; versus = ' vs load factor'
+    else
+      x_of = 'ms(c) = column(c)*1.0e3   # s -> ms'
+      x_label = 'time [ms]'; versus = ' vs time'
+    end if
     s = '# Time-history plots of a casca run, written by casca from the header of history.dat.' &
         //nl//'# Edit freely and re-run inside the run folder with:  gnuplot plots.gp'//nl// &
         '# history.dat is in SI units (s, m, J, N); time is plotted in ms.'//nl//nl// &
@@ -222,7 +268,7 @@ contains
     end do
 
     s = s//nl// &
-        'ms(c) = column(c)*1.0e3   # s -> ms'//nl// &
+        x_of//nl// &
         'imax(a, b) = (a > b) ? a : b'//nl//nl// &
         '# Terminal: cairo if available (antialiased), else libgd. Text is not "enhanced", so'//nl// &
         '# labels with _ or ^ print literally; units use UTF-8 characters instead.'//nl// &
@@ -241,7 +287,7 @@ contains
         'set offsets 0, 0, graph 0.05, graph 0.05'//nl// &
         '# axes fit the data (plus the offsets above) instead of growing to the next tic'//nl// &
         'set autoscale fix'//nl// &
-        "set xlabel 'time [ms]'"//nl// &
+        "set xlabel '"//x_label//"'"//nl// &
         'set linetype 1 lc rgb "#1f77b4" lw 2 dt 1'//nl// &
         'set linetype 2 lc rgb "#d62728" lw 2 dt 1'//nl// &
         'set linetype 3 lc rgb "#2ca02c" lw 2 dt 1'//nl// &
@@ -258,7 +304,7 @@ contains
       do a = 1, 3
         s = s//'# '//axis(a)//' position of every tracked node'//nl// &
             "set output 'positions_"//axis(a)//".png'"//nl// &
-            "set title 'Position in "//axis(a)//" of the tracked nodes vs time'"//nl// &
+            "set title 'Position in "//axis(a)//" of the tracked nodes"//versus//"'"//nl// &
             "set ylabel '"//axis(a)//" [m]'"//nl//'plot '
         do k = 1, nk
           v = 'c_p'//itoa(k)//'_'//axis(a)
@@ -273,7 +319,7 @@ contains
       s = s//'# x, y, z displacement of every tracked node from its first row'//nl// &
           'set terminal @term size 1000,1100'//nl// &
           "set output 'displacements.png'"//nl// &
-          "set multiplot layout 3,1 title 'Displacement of the tracked nodes vs time' font ',15'"//nl
+          "set multiplot layout 3,1 title 'Displacement of the tracked nodes"//versus//"' font ',15'"//nl
       do a = 1, 3
         s = s//"set title '"//axis(a)//"'"//nl//"set ylabel 'u_"//axis(a)//" [m]'"//nl
         if (a == 3) s = s//'set key below horizontal spacing 1.2 width 2'//nl
@@ -294,7 +340,7 @@ contains
 
     s = s//'# Energy balance'//nl// &
         "set output 'energy.png'"//nl// &
-        "set title 'Energies vs time'"//nl// &
+        "set title 'Energies"//versus//"'"//nl// &
         "set ylabel 'energy [J]'"//nl// &
         "plot datafile using (ms(c_t)):(column(c_kinetic)) with lines lt 1 title 'kinetic', \"//nl// &
         "     datafile using (ms(c_t)):(column(c_strain)) with lines lt 2 title 'strain', \"//nl// &
@@ -304,7 +350,7 @@ contains
     s = s//'# Linear (top) and angular (bottom) momentum'//nl// &
         'set terminal @term size 1000,800'//nl// &
         "set output 'momentum.png'"//nl// &
-        "set multiplot layout 2,1 title 'Momentum vs time' font ',15'"//nl// &
+        "set multiplot layout 2,1 title 'Momentum"//versus//"' font ',15'"//nl// &
         "set title 'linear momentum'"//nl// &
         "set ylabel 'p [kg"//mdot//"m/s]'"//nl// &
         "plot datafile using (ms(c_t)):(column(c_px)) with lines lt 1 title 'px', \"//nl// &
@@ -324,7 +370,7 @@ contains
         "stats datafile using c_contacts nooutput name 'CONT'"//nl// &
         "stats datafile using c_fcontact nooutput name 'FCON'"//nl// &
         "set output 'contact.png'"//nl// &
-        "set title 'Contact vs time'"//nl// &
+        "set title 'Contact"//versus//"'"//nl// &
         "set ylabel 'active contacts [-]' textcolor lt 1"//nl// &
         "set y2label 'total contact force [N]' textcolor lt 2"//nl// &
         'set yrange [0:imax(1, CONT_max*1.1)]'//nl// &

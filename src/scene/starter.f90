@@ -28,7 +28,7 @@ module casca_starter
   use casca_model, only: model_t, body_t, dof, element_dofs, area_points, element_area
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
-  use casca_strings, only: itoa, rtoa, vtoa, count_of
+  use casca_strings, only: itoa, rtoa, vtoa, ftoa, count_of
   use casca_scene, only: scene_contact, initial_state, tracked_nodes, area_per_node, clearly
   use casca_newmark, only: state_t
   use casca_contact, only: contact_t, search_radius, tested_both_ways
@@ -37,7 +37,7 @@ module casca_starter
   implicit none
   private
   public :: body_facts_t, body_facts, starter_report, thickness_frequency, put_warnings, contact_time, spring_time
-  public :: static_warnings
+  public :: deck_warnings
 
   !> Below this element quality a warning names the element: the area scale of its map then
   !> varies by more than a factor 2 over it
@@ -154,19 +154,33 @@ contains
     if (deck%run%analysis == 'dynamic') call time_line(deck, model, out)
     call put_warnings(body_warnings(model, f), err)
     call put_warnings(pair_warnings(deck, model), err)
-    call put_warnings(static_warnings(deck), err)
+    call put_warnings(deck_warnings(deck), err)
     call tracked_nodes(deck, model, tracked, far)
     call put_warnings(far, err)
   end subroutine starter_report
 
-  !> What statics leave out of a deck that gives it: the obstacles' motion (they stay where
-  !> they are at t = 0); and bodies that no restraint holds
-  function static_warnings(deck) result(w)
+  !> What the deck's settings mean that it may not intend: frames between the fixed steps'
+  !> ends; in statics, the obstacles' motion left out (they stay where they are at t = 0) and
+  !> bodies that no restraint holds
+  function deck_warnings(deck) result(w)
     type(deck_t), intent(in) :: deck
     character(len=400), allocatable :: w(:)
+    real(dp) :: interval, steps
     integer :: k
     allocate (w(0))
-    if (deck%run%analysis /= 'static') return
+    if (deck%run%analysis /= 'static') then
+      ! (a frame is written at the first step's end at or past its time; with a tolerance the
+      ! steps are the interval halved and end on it)
+      interval = deck%output%interval
+      if (interval == unset) interval = deck%run%t_end/100
+      steps = interval/deck%run%dt
+      if (deck%run%tolerance == unset .and. steps > 1 .and. abs(steps - anint(steps)) > 1e-6_dp*steps) &
+        w = [character(len=400) :: w, '&output interval '//rtoa(interval)//' s is '//ftoa(steps)// &
+             ' steps of dt: each frame is written at the end of the first step past its time, up to '// &
+             'dt late (run.pvd gives each its own time); an interval of a whole number of steps '// &
+             'puts them on time']
+      return
+    end if
     do k = 1, size(deck%obstacles)
       if (any(deck%obstacles(k)%velocity /= 0)) w = [character(len=400) :: w, 'obstacle '''// &
         trim(deck%obstacles(k)%name)//''' has a velocity, but in statics the obstacles stay '// &
@@ -176,9 +190,11 @@ contains
       if (any(deck%restraints(:)%body == deck%bodies(k)%name)) cycle
       w = [character(len=400) :: w, 'body '''//trim(deck%bodies(k)%name)//''' has no '// &
         '&restraint: in statics only contacts can hold it against the loads, and if none '// &
-        'does from the first load step there is no equilibrium to find']
+        'does from the first load step there is no equilibrium to find (loads that balance '// &
+        'each other, a pressure on a closed surface, have one: restraining its rigid motion '// &
+        'at three nodes, 3-2-1, finds it directly, not by the damped path)']
     end do
-  end function static_warnings
+  end function deck_warnings
 
   !> The warning lines w, each 'warning: ...', to unit u
   subroutine put_warnings(w, u)

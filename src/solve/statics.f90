@@ -18,6 +18,7 @@
 !> load, and the body goes further than the scene's size), and is an error naming it.
 module casca_statics
   use casca_kinds, only: dp
+  use casca_strings, only: rtoa, itoa
   use casca_error, only: error_t, fatal_error
   use casca_model, only: model_t, element_dofs
   use casca_mpi, only: sum_all
@@ -59,10 +60,10 @@ contains
     type(contact_t), intent(inout), optional :: contact
     real(dp) :: at, step
     integer :: level, iters, k
-    logical :: unheld, tried
-    character(len=120) :: msg
+    logical :: unheld
+    integer :: tries   !< stabilised solves tried (module comment)
     type(constraint_t), allocatable :: before(:)
-    at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tried = .false.
+    at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tries = 0
     if (present(contact)) contact%opt%stick_at_touch = .true.
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
@@ -76,10 +77,13 @@ contains
       call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
                         load_factor=at + step)   ! the pressures scaled too (issue 17)
       if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
-      ! (first taken to be a body that nothing holds yet; once per load step, the halvings
-      ! are Newton's: a sphere past its buckling pressure spent 55 s more otherwise)
-      if (allocated(err) .and. .not. tried) then
-        iters = iters + rep%iters; tried = .true.
+      ! (first taken to be a body that nothing holds yet; on the load step and on its first
+      ! half, the further halvings are Newton's: a sphere past its buckling pressure spent
+      ! 55 s more with it at every halving, and a hemisphere under its whole load in one
+      ! step, whose whole step was too far for it, stopped at 1/16 of the load where its half
+      ! step took it, as two load steps did)
+      if (allocated(err) .and. (tries == 0 .or. (tries == 1 .and. level == 1))) then
+        iters = iters + rep%iters; tries = tries + 1
         deallocate (err)
         call stabilised_solve(model, asm, ls, fext*(at + step), at + step, opts, q, rep, err, &
                               unheld, contact)
@@ -88,9 +92,8 @@ contains
       iters = iters + rep%iters
       if (allocated(err)) then
         if (level >= max_cuts .or. unheld) then   ! (a smaller load does not hold a body)
-          write (msg, '(a,g0.6,a,i0,a)') 'static Newton did not converge at load factor ', &
-            at + step, ' (after ', level, ' halvings of the load step): '
-          err%message = trim(msg)//' '//err%message
+          err%message = 'static Newton did not converge at load factor '//rtoa(at + step)//' (after '// &
+                        itoa(level)//' halvings of the load step): '//err%message
           return
         end if
         level = level + 1   ! q is unchanged: half the increment

@@ -1,0 +1,289 @@
+!> What a run watches as it goes and warns of where it ends or stops: the energy a step
+!> made, the least stretches through the thickness and along the faces, Coulomb's bound
+module casca_run_watch
+  use casca_kinds, only: dp
+  use casca_deck, only: deck_t
+  use casca_starter, only: contact_time
+  use casca_model, only: thinnest, least_face_stretch
+  use casca_accounting, only: energy_term_t, balance_remainder
+  use casca_contact, only: contact_t
+  use casca_contact_rows, only: pair_stored_energy
+  use casca_mpi, only: is_root
+  use casca_strings, only: count_of, rtoa, vtoa, ftoa, itoa
+  use casca_run_state, only: run_t, least_t, svk_limit
+  implicit none
+  private
+  public :: watch_energy, watch_thickness, watch_faces, squeezed, squeeze_note, rest_now, step_judged, &
+            warn_dynamic, balance_terms, moving_obstacles
+
+contains
+
+  !> Keep the largest energy one step made: E0 less what the bodies hold and the terms
+  !> taken out (energy_balance's remainder) is what the integrator and the contact removed,
+  !> and it may only grow with a dissipative scheme (stay, with a conservative one)
+  subroutine watch_energy(r, rest, start, h_before)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
+    type(contact_t), intent(in), optional :: start   !< the contact at the step's start
+    real(dp), intent(in), optional :: h_before   !< the step before's length if it was free, else 0
+    if (step_judged(r) .and. r%rest_last - rest > r%made_max) then
+      r%made_max = r%rest_last - rest; r%t_made = r%st%t; r%dt_made = r%nm%dt
+      r%dt_made_before = 0
+      if (present(h_before) .and. r%sc%tol <= 0) then   ! (fixed steps, grown back after cuts)
+        if (h_before > 0 .and. r%nm%dt > 1.5_dp*h_before) r%dt_made_before = h_before
+      end if
+      r%made_contacts = 0; r%made_between = 0   ! (those of a step that released them acted in it too)
+      if (allocated(r%contact)) call count_active(r%contact)
+      if (present(start)) call count_active(start)
+    end if
+    r%rest_last = rest
+    r%e_scale = max(r%e_scale, abs(r%bal%total), r%bal%kinetic + r%bal%strain, abs(r%bal%work))
+  contains
+    subroutine count_active(c)
+      type(contact_t), intent(in) :: c
+      r%made_contacts = max(r%made_contacts, c%set%nact)
+      r%made_between = max(r%made_between, count(c%pair(2, c%set%act(1:c%set%nact)%pair) > 0))
+    end subroutine count_active
+  end subroutine watch_energy
+
+  !> Keep the least thickness stretch of the run's states (thinnest; every step)
+  subroutine watch_thickness(r)
+    type(run_t), intent(inout) :: r
+    real(dp) :: stretch
+    integer :: node
+    call thinnest(r%model, r%st%q, node, stretch)
+    call keep_least(r%thick, stretch, node, r%st%t)
+  end subroutine watch_thickness
+
+  !> Keep the least stretch along the faces (least_face_stretch): at the frames' times and where
+  !> the run ends or stops, as it costs about 0.6 us an element, 1.5% of a step of the three
+  !> spheres
+  subroutine watch_faces(r)
+    type(run_t), intent(inout) :: r
+    real(dp) :: stretch
+    integer :: node
+    if (.not. (allocated(r%model%face_metric) .and. allocated(r%st%q))) return   ! (stopped before)
+    call least_face_stretch(r%model, r%st%q, node, stretch)
+    call keep_least(r%face, stretch, node, r%st%t)
+  end subroutine watch_faces
+
+  pure subroutine keep_least(least, stretch, node, t)
+    type(least_t), intent(inout) :: least
+    real(dp), intent(in) :: stretch, t
+    integer, intent(in) :: node
+    if (stretch < svk_limit .and. least%t_past < 0) least%t_past = t
+    if (stretch < least%stretch) least = least_t(stretch, t, node, least%t_past)
+  end subroutine keep_least
+
+  !> A shell squeezed past Saint-Venant-Kirchhoff's limit (svk_limit), through its thickness
+  !> or along a face: squeezed further its stress falls, so the equations lose their solution
+  !> there (a rubber ring thrown at a floor at 15 m/s reached 0.2 through its thickness, a
+  !> ring crushed flat folded to 0.4 along its inner face; Newton stalled)
+  logical function squeezed(r)
+    type(run_t), intent(in) :: r
+    squeezed = min(r%thick%stretch, r%face%stretch) < svk_limit
+  end function squeezed
+
+  function squeeze_note(r) result(msg)
+    type(run_t), intent(in) :: r
+    character(len=:), allocatable :: msg
+    msg = ''
+    if (r%thick%stretch < svk_limit) then
+      if (r%thick%stretch <= 0) then
+        msg = at(r%thick, 'turned inside out through its thickness')
+      else
+        msg = at(r%thick, 'squeezed through its thickness to '//itoa(nint(100*r%thick%stretch))//'%')
+      end if
+    end if
+    if (r%face%stretch < svk_limit) then
+      if (len(msg) > 0) msg = msg//', and '
+      msg = msg//at(r%face, 'compressed along its face to '//itoa(nint(100*r%face%stretch))// &
+            '% (folded or bent tighter than its thickness allows)')
+    end if
+    msg = msg//'; the Saint-Venant-Kirchhoff material holds to '//itoa(nint(100*svk_limit))// &
+          '% only (squeezed further, its stress falls): the results there are beyond the material law'
+    if (r%thick%stretch < svk_limit) msg = msg//' (a slower impact, or a thicker or stiffer shell, stays within it)'
+  contains
+    function at(least, how) result(s)
+      type(least_t), intent(in) :: least
+      character(len=*), intent(in) :: how
+      character(len=:), allocatable :: s
+      integer :: b
+      b = r%model%node_body(least%node)
+      s = 'body '''//r%model%body(b)%name//''' was '//how//' at its node '// &
+          itoa(least%node - r%model%body(b)%node_first + 1)//' (at '// &
+          vtoa(r%model%x0(:, least%node))//' at the start) at t = '//rtoa(least%t)//' s'
+      if (least%t_past < least%t) s = s//' (below '//itoa(nint(100*svk_limit))//'% from t = '// &
+                                      rtoa(least%t_past)//' s)'
+    end function at
+  end function squeeze_note
+
+
+  !> energy_balance's remainder at the run's state: E0 less what the bodies hold and the
+  !> terms taken out (what the integrator and the contact removed so far)
+  real(dp) function rest_now(r)
+    type(run_t), intent(in) :: r
+    rest_now = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact))
+  end function rest_now
+
+  !> Whether the step just taken is judged for the energy it made: not the first of a start
+  !> held by its contact (held_at_start)
+  logical function step_judged(r)
+    type(run_t), intent(in) :: r
+    step_judged = r%st%step > merge(1, 0, r%held_at_start)
+  end function step_judged
+
+  !> What a dynamic run warns of at its end or stop (rank 0): energy made, Coulomb's bound
+  subroutine warn_dynamic(r)
+    type(run_t), intent(in) :: r
+    if (.not. is_root() .or. r%deck%run%analysis == 'static') return
+    call warn_energy(r)
+    call warn_coulomb(r)
+    call warn_sink(r)
+  end subroutine warn_dynamic
+
+  !> Hard contact holds each node within its tolerance, but a node left free of a constraint
+  !> that would repeat one held the other way (two passes, self-contact) may sink: where it
+  !> sank more than a tenth of its shell's thickness, say so (two thin spheres glancing at
+  !> 50 m/s with passes = 2: 30% of h, in silence)
+  subroutine warn_sink(r)
+    type(run_t), intent(in) :: r
+    integer :: b
+    if (.not. allocated(r%contact) .or. r%sink_node == 0) return
+    if (r%contact%opt%compliant) return   ! (a spring's depth is its force over its stiffness)
+    b = r%model%node_body(r%sink_node)
+    if (r%sink <= 0.1_dp*r%model%body(b)%thickness) return
+    write (0, '(a)') 'warning: a contact node of body '''//trim(r%model%body(b)%name)//''' sank '// &
+      rtoa(r%sink)//' m ('//itoa(nint(100*r%sink/r%model%body(b)%thickness))//'% of its thickness) '// &
+      'into its target at t = '//rtoa(r%t_sink)//' s (its node '// &
+      itoa(r%sink_node - r%model%body(b)%node_first + 1)//'; the penetration column of history.dat): '// &
+      'a node pressed on an element that holds a node pressed back is left free of the constraint '// &
+      'that would repeat the other''s, may sink, and is held where it is found (passes = 2, '// &
+      'self-contact; README, &contact passes); with passes = 1 (the denser mesh as impactor) or a '// &
+      'compliant contact (stiffness) no constraint is left out'
+  end subroutine warn_sink
+
+  !> Coulomb's bound over the run, where it can be read from the impulse column: a pair with a
+  !> plane obstacle (one normal) takes at most mu times its normal impulse along the plane. The
+  !> trapezoidal rule's contact forces ring, and the friction of a hoop hopping on a floor came
+  !> to 0.56 of its normal impulse at mu 0.3 (the acceleration's projection moves the normal
+  !> share of the step's start, not the friction's: docs/performance.md)
+  subroutine warn_coulomb(r)
+    type(run_t), intent(in) :: r
+    real(dp) :: jn, jt, mu
+    integer :: p
+    if (.not. allocated(r%contact)) return
+    associate (c => r%contact)
+      do p = 1, c%npairs
+        if (c%pair(2, p) >= 0) cycle
+        if (c%obstacle(-c%pair(2, p))%shape /= 'plane') cycle
+        mu = max(c%mu_d(p), c%mu_s(p))
+        if (mu <= 0) cycle
+        jn = dot_product(c%impulse(:, p), c%obstacle(-c%pair(2, p))%normal)
+        jt = norm2(c%impulse(:, p) - jn*c%obstacle(-c%pair(2, p))%normal)
+        if (jn <= 0 .or. jt <= 1.02_dp*mu*jn) cycle
+        write (0, '(a)') 'warning: pair '''//trim(r%model%body(c%pair(1, p))%name)//''' -> '''// &
+          trim(c%obstacle(-c%pair(2, p))%name)//''': its friction impulse is '//ftoa(jt/jn)// &
+          ' of its normal impulse, above its coefficient '//ftoa(mu)//' (Coulomb''s bound): '// &
+          'the contact forces rang from step to step'//trim(ringing())
+      end do
+    end associate
+  contains
+    function ringing() result(s)
+      character(len=:), allocatable :: s
+      s = '; a shorter dt brings it nearer'
+      if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) s = ' ('//r%nm%describe()//' keeps them '// &
+        'undamped: rho_inf = 0.8 (generalized-alpha) damps them)'
+    end function ringing
+  end subroutine warn_coulomb
+
+  !> A run from t = 0 whose step made more than 1e-3 of E0 says so: with contact active most
+  !> often the contact's doing; with none, the time scheme's, over a motion its steps do not
+  !> follow (the schemes keep or remove the energy of linear vibrations, not of every
+  !> nonlinear one)
+  subroutine warn_energy(r)
+    type(run_t), intent(in) :: r
+    character(len=:), allocatable :: made, why, shorter
+    real(dp) :: e0, tc
+    integer :: b
+    e0 = abs(r%bal0%total)
+    if (r%restart_step >= 0 .or. .not. r%made_max > 1e-3_dp*max(e0, r%e_scale)) return
+    if (e0 >= 1e-3_dp*r%e_scale) then
+      made = ftoa(100*r%made_max/e0)//'% of the initial energy'
+    else   ! (a scene that starts at rest under its loads)
+      made = rtoa(r%made_max)//' J (the bodies held at most '//rtoa(r%e_scale)//' J)'
+    end if
+    why = 'a node that came deep into a target in one step'
+    if (allocated(r%contact) .and. r%made_between > 0) then   ! (closed shells have no rim)
+      if (any(r%contact%rim)) why = 'a shell''s edge that passed between the other''s nodes (casca has '// &
+                                    'no edge-to-edge contact; with one pass, test the edge''s body as impactor or '// &
+                                    'set passes = 2), or a node that came deep into a target in one step'
+    end if
+    ! (under a tolerance the steps in contact are the error estimate's, which leaves the
+    ! contact nodes out: two balls head-on made 0.24% in a 100 us step at 1e-3)
+    shorter = 'a shorter dt'
+    if (r%sc%tol > 0) shorter = 'a smaller tolerance'
+    why = why//'; look at the frames there, or take '//shorter
+    ! (an 80-degree plate landing edge-first under the trapezoidal rule: 0.72% of E0, the same
+    ! between mid-surfaces, no node edge-on or deep)
+    if (r%nm%gamma <= 0.5_dp .and. r%nm%rho_inf < 0) why = why//'; or the impact''s ringing, '// &
+      'which '//r%nm%describe()//' keeps undamped: rho_inf = 0.8 (generalized-alpha) damps it'
+    if (r%made_contacts == 0 .and. r%dt_made_before > 0) then
+      ! (a hoop hopping on a floor, its steps halved to 0.25 ms: 0.23% in the step that grew
+      ! back to 0.5 ms, its strain energy alternating for ten steps after)
+      why = 'with no contact, in a step that had grown back to '//rtoa(r%dt_made)//' s after cuts to '// &
+            rtoa(r%dt_made_before)//' s: the start acceleration of the shorter steps rang in the longer '// &
+            'one; take a shorter dt (the cuts say how much shorter), or give a tolerance (&run)'
+    else if (r%made_contacts == 0) then
+      why = 'with no contact, the time scheme made it over a motion its steps do not follow, '// &
+            'as a spinning thin shell''s breathing under steps longer than its period (a stiff '// &
+            'shell holds much energy in a small error); '
+      if (r%sc%tol > 0) then   ! (with moving obstacles or pressures: not bounded step by step)
+        why = why//'take a smaller tolerance'
+      else
+        why = why//'take a shorter dt, or give a tolerance (&run), which also bounds the '// &
+              'energy a step makes while no contact is active'
+      end if
+    else if (allocated(r%contact)) then
+      if (r%contact%opt%compliant) then   ! (a spring whose steps are too long for it)
+        tc = contact_time(r%deck, r%model, b)
+        why = 'the compliant contact''s time pi sqrt(rho h / stiffness) is '// &
+              rtoa(tc/r%dt_made)//' steps of that step ('//rtoa(r%dt_made)//' s) for body '''// &
+              trim(r%model%body(b)%name)//'''; take '//shorter//' or a lower stiffness'
+      end if
+    end if
+    write (0, '(a)') 'warning: the step to t = '//rtoa(r%t_made)//' s made '//made//', with '// &
+      count_of(r%made_contacts, 'contact', 'contacts')//' active at its start or end: '//why
+  end subroutine warn_energy
+
+  !> The energy balance's terms that the scene has: friction's, moving obstacles', a
+  !> compliant contact's; with corrections, a hard contact's velocity corrections' (the
+  !> printed balance: a step's energy is judged with them in the remainder, as it was tuned)
+  function balance_terms(deck, contact, corrections) result(terms)
+    type(deck_t), intent(in) :: deck
+    type(contact_t), intent(in), optional :: contact
+    logical, intent(in), optional :: corrections
+    type(energy_term_t), allocatable :: terms(:)
+    allocate (terms(0))
+    if (.not. present(contact)) return
+    if (any(contact%mu_d > 0)) terms = [terms, energy_term_t('dissipated by friction', &
+                                                             sum(contact%friction_work))]
+    if (moving_obstacles(deck, .true.)) &
+      terms = [terms, energy_term_t('taken from moving obstacles', -contact%obstacle_work, &
+                                                          source=.true.)]
+    if (contact%opt%compliant) then
+      terms = [terms, energy_term_t('held in the contact stiffness', sum(pair_stored_energy(contact)))]
+    else if (present(corrections)) then
+      if (corrections) terms = [terms, energy_term_t('taken out by the velocity corrections', &
+                                                     sum(contact%correction_loss))]
+    end if
+  end function balance_terms
+
+  logical function moving_obstacles(deck, use_contact)
+    type(deck_t), intent(in) :: deck
+    logical, intent(in) :: use_contact
+    integer :: k
+    moving_obstacles = use_contact .and. any([(any(deck%obstacles(k)%velocity /= 0), &
+                                               k=1, size(deck%obstacles))])
+  end function moving_obstacles
+end module casca_run_watch
