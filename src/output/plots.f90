@@ -67,7 +67,7 @@ contains
     if (present(static)) then
       by_load = static
     else
-      by_load = at_rest(hist, col(3))
+      by_load = at_rest(hist, col(findloc(req_names, 'kinetic', dim=1)))
     end if
     script = gnuplot_script(col, pcol, labels, by_load)
     call write_text(d//'/plots.gp', script, err)
