@@ -265,14 +265,20 @@ contains
     logical, intent(in) :: stick
     integer, intent(out) :: changed
     integer :: released, added
+    logical :: one_off
     changed = 0
     if (stick) call friction_update(c, changed)
     if (changed > 0) return
+    one_off = c%set%cycling   ! (then the tensile go one at a time)
     call contact_release(c, released, keep_stuck=.not. stick)
     call contact_update(c, model, q, .true., added, reproject=.false.)
     changed = released + added
     if (changed == 0) return
-    c%set%decisions = c%set%decisions + 1
+    ! a cycling set let go one at a time shrinks, and the step's iterations bound it: not
+    ! counted (a thin hoop rolling under rho_inf 0.8 went from 7 constraints to its 2 in six
+    ! such releases, and ran out of decisions at the last: its step was cut, 18 Newton
+    ! iterations a step)
+    if (.not. (one_off .and. added == 0)) c%set%decisions = c%set%decisions + 1
     call remember_set(c%set, c%npairs)
   end subroutine contact_settle
 
