@@ -193,7 +193,7 @@ contains
     else if (c%opt%nodal_normal) then
       con%n = 0
       do j = 1, 10
-        call node_normal_sum(c, model, x, con%elem, j, m, normals)
+        call node_normal_sum(c, model, x, model%conn(j, con%elem), m, normals)
         con%n = con%n + (con%shp(j)/norm2(m))*m
       end do
     else
@@ -564,7 +564,7 @@ contains
       else
         u = 0
         do j = 1, 10   ! (forward, as constraint_geometry)
-          call node_normal_sum(c, model, x, con%elem, j, m(:, j), normals)
+          call node_normal_sum(c, model, x, model%conn(j, con%elem), m(:, j), normals)
           u = u + (shp(j)/norm2(m(:, j)))*m(:, j)
         end do
         bu = u/norm2(u)
@@ -638,21 +638,20 @@ contains
     end if
   end function element_normal
 
-  !> m: the sum of the unit normals, at element e's node k, of every element there (the
-  !> nodal normal's direction). The mesh's orientation is consistent (scene.f90 refuses one
-  !> that is not), so each is taken as it is, as the fibres' sum at the start is (model.f90):
-  !> each turned to e's side by the sign of its dot product with e's, the sides of a square
+  !> m: the sum of the unit normals, at node nd, of every element there (the nodal normal's
+  !> direction). The mesh's orientation is consistent (scene.f90 refuses one that is not), so
+  !> each is taken as it is, as the fibres' sum at the start is (model.f90): each turned to
+  !> one element's side by the sign of its dot product with that one's, the sides of a square
   !> tube's 90-degree crease were turned either way by round-off, and the normal there lay
   !> along the wall (a can's node 2.6 mm off the crease was taken as touching: Newton failed)
-  subroutine node_normal_sum(c, model, x, e, k, m, normals)
+  subroutine node_normal_sum(c, model, x, nd, m, normals)
     type(contact_t), intent(in) :: c
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: x(:, :)
-    integer, intent(in) :: e, k
+    integer, intent(in) :: nd
     real(dp), intent(out) :: m(3)
     type(normal_cache_t), intent(inout), optional :: normals
-    integer :: i, nd
-    nd = model%conn(k, e)
+    integer :: i
     m = 0
     do i = c%geo%node_start(nd), c%geo%node_start(nd + 1) - 1
       m = m + element_normal(c, model, x, c%geo%node_elem(i), c%geo%node_loc(i), normals)

@@ -205,11 +205,8 @@ contains
           end do
           m = m + 1; irn(m) = neq + r; jcn(m) = neq + r; val(m) = 0; fval(m) = 0
           if (kind == 0) val(m) = -normal_compliance(c, a)
-          if (kind /= 0 .and. kind /= across .and. w == 0) val(m) = -1
-          if (kind == across) then
-            val(m) = -1
-            if (w > 0) val(m) = -1/ks
-          end if
+          if (kind /= 0 .and. w == 0) val(m) = -1   ! (an empty row: its multiplier stays)
+          if (kind == across .and. w > 0) val(m) = -1/ks
         end do
         ! a rim fibre's curvature: Newton's stiffness -lambda wgg along n on the node's fibre,
         ! the row's compliance (eliminated, as across a slip; multiplier 0 at each iterate).

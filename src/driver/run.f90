@@ -5,7 +5,7 @@ module casca_run
   use, intrinsic :: iso_fortran_env, only: output_unit
   use casca_kinds, only: dp, pi
   use casca_error, only: error_t
-  use casca_deck, only: deck_t, read_deck, unset, add_problem, default_newton_tol
+  use casca_deck, only: deck_t, read_deck, unset, add_problem, default_newton_tol, frame_interval
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
   use casca_starter, only: put_warnings, spring_time, deck_warnings
@@ -42,8 +42,8 @@ module casca_run
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   use casca_run_state, only: run_t, progress_t, exit_ok, exit_input, exit_solver, exit_signal, cap_hold, &
                              newton_share, newton_floor
-  use casca_run_watch, only: watch_energy, watch_thickness, watch_faces, squeezed, squeeze_note, rest_now, &
-                             step_judged, warn_dynamic, balance_terms, moving_obstacles
+  use casca_run_watch, only: watch_energy, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, &
+                             rest_now, step_judged, warn_dynamic, balance_terms, moving_obstacles
   implicit none
   private
   public :: load_scene, run_deck, exit_ok, exit_input
@@ -435,9 +435,7 @@ contains
           max(newton_floor, newton_share*r%sc%tol*r%sc%length/model%length))
         if (r%dt_try == 0) r%dt_try = dt
       end if
-      interval = deck%output%interval
-      if (interval == unset) interval = deck%run%t_end/100
-      interval = max(interval, dt)
+      interval = frame_interval(deck)
       next_frame = next_multiple(st%t, interval)
       next_ckpt = huge(1._dp)
       if (deck%output%checkpoint_interval > 0) &
@@ -448,10 +446,7 @@ contains
         call account_state(r)
         r%bal0 = r%bal
         call watch_energy(r, rest_now(r))
-        call history_row(r, 0)
-        if (failed(r, 'history')) return
-        call frame(r)
-        if (failed(r, 'frame')) return
+        if (.not. row_and_frame(r, 0)) return
       else   ! (the energy before the first step, for the first step's check)
         call account_state(r)
         r%rest_last = rest_now(r)
@@ -510,10 +505,7 @@ contains
         next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
       if (st%step == 0) then   ! (the unloaded state, as a dynamic run's t = 0: frames and plots start undeformed)
         call account_state(r, factor=0._dp)
-        call history_row(r, 0)
-        if (failed(r, 'history')) return
-        call frame(r)
-        if (failed(r, 'frame')) return
+        if (.not. row_and_frame(r, 0)) return
       end if
       do i = st%step + 1, deck%run%load_steps
         call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/deck%run%load_steps, &
@@ -525,10 +517,7 @@ contains
         call account_state(r, factor=st%t)   ! (issue 17)
         call watch_thickness(r)
         call watch_faces(r)
-        call history_row(r, r%rep%iters)
-        if (failed(r, 'history')) return
-        call frame(r)
-        if (failed(r, 'frame')) return
+        if (.not. row_and_frame(r, r%rep%iters)) return
         if (is_root() .and. .not. r%quiet) print '(a,i4,a,f6.3,a,i3,a)', 'load step', i, &
           '  factor', st%t, '  newton', r%rep%iters, &
           trim(merge('  stabilised', '            ', stabilised > 0))
@@ -948,9 +937,7 @@ contains
     if (allocated(r%contact)) then
       associate (c => r%contact)
         call contact_penetration(c, r%model, r%st%q, pen, gmax, node)
-        if (pen > r%sink) then
-          r%sink = pen; r%sink_node = node; r%t_sink = r%st%t
-        end if
+        call watch_sink(r, pen, node)
         if (c%set%nact > 0) lmax = maxval(c%set%act(1:c%set%nact)%lambda)
         call output_history(r%out, r%st, r%bal, c%set%nact, contact_force_total(c), newton, &
                             max(pen, 0._dp), r%rep%neg_pivots, lmax, gmax, &
@@ -963,6 +950,18 @@ contains
                           [real(dp) ::], [integer ::], [real(dp) ::], r%err)
     end if
   end subroutine history_row
+
+  !> The state's history row (newton: its Newton iterations) and frame; .false. when either
+  !> failed (failed says so)
+  logical function row_and_frame(r, newton) result(ok)
+    type(run_t), intent(inout) :: r
+    integer, intent(in) :: newton
+    call history_row(r, newton)
+    ok = .not. failed(r, 'history')
+    if (.not. ok) return
+    call frame(r)
+    ok = .not. failed(r, 'frame')
+  end function row_and_frame
 
   subroutine frame(r)
     type(run_t), intent(inout) :: r

@@ -1,5 +1,6 @@
 !> What a run watches as it goes and warns of where it ends or stops: the energy a step
-!> made, the least stretches through the thickness and along the faces, Coulomb's bound
+!> made, the least stretches through the thickness and along the faces, the deepest a node
+!> sank, Coulomb's bound
 module casca_run_watch
   use casca_kinds, only: dp
   use casca_deck, only: deck_t
@@ -13,8 +14,8 @@ module casca_run_watch
   use casca_run_state, only: run_t, least_t, svk_limit
   implicit none
   private
-  public :: watch_energy, watch_thickness, watch_faces, squeezed, squeeze_note, rest_now, step_judged, &
-            warn_dynamic, balance_terms, moving_obstacles
+  public :: watch_energy, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, rest_now, &
+            step_judged, warn_dynamic, balance_terms, moving_obstacles
 
 contains
 
@@ -66,6 +67,16 @@ contains
     call least_face_stretch(r%model, r%st%q, node, stretch)
     call keep_least(r%face, stretch, node, r%st%t)
   end subroutine watch_faces
+
+  !> Keep the deepest a contact node sank into its target (the history row's penetration,
+  !> depth, at its node): warn_sink tells of it
+  pure subroutine watch_sink(r, depth, node)
+    type(run_t), intent(inout) :: r
+    real(dp), intent(in) :: depth
+    integer, intent(in) :: node
+    if (depth <= r%sink) return
+    r%sink = depth; r%sink_node = node; r%t_sink = r%st%t
+  end subroutine watch_sink
 
   pure subroutine keep_least(least, stretch, node, t)
     type(least_t), intent(inout) :: least

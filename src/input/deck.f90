@@ -20,7 +20,7 @@ module casca_deck
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
   public :: contact_cfg_t, obstacle_cfg_t, read_deck, add_problem, max_track, unset, deck_file, default_newton_tol
-  public :: counts_for_size
+  public :: counts_for_size, frame_interval
 
   integer, parameter :: max_track = 16
   integer, parameter :: max_pairs = 64
@@ -164,6 +164,15 @@ module casca_deck
   end type deck_t
 
 contains
+
+  !> The time between frames of a dynamic run: &output interval (t_end/100 when not given),
+  !> at least one step dt
+  pure real(dp) function frame_interval(deck) result(interval)
+    type(deck_t), intent(in) :: deck
+    interval = deck%output%interval
+    if (interval == unset) interval = deck%run%t_end/100
+    interval = max(interval, deck%run%dt)
+  end function frame_interval
 
   !> A file named in the deck: relative names are relative to the deck's folder.
   function deck_file(deck, name) result(path)

@@ -24,7 +24,7 @@
 module casca_starter
   use casca_kinds, only: dp, pi
   use casca_mesh, only: nen
-  use casca_deck, only: deck_t, unset
+  use casca_deck, only: deck_t, unset, frame_interval
   use casca_model, only: model_t, body_t, dof, element_dofs, area_points, element_area
   use casca_shape_tri10, only: tri10_shape, tri10_normal
   use casca_orientation, only: edge_census_t, edge_census, signed_volume
@@ -171,10 +171,9 @@ contains
     if (deck%run%analysis /= 'static') then
       ! (a frame is written at the first step's end at or past its time; with a tolerance the
       ! steps are the interval halved and end on it)
-      interval = deck%output%interval
-      if (interval == unset) interval = deck%run%t_end/100
+      interval = frame_interval(deck)
       steps = interval/deck%run%dt
-      if (deck%run%tolerance == unset .and. steps > 1 .and. abs(steps - anint(steps)) > 1e-6_dp*steps) &
+      if (deck%run%tolerance == unset .and. abs(steps - anint(steps)) > 1e-6_dp*steps) &
         w = [character(len=400) :: w, '&output interval '//rtoa(interval)//' s is '//ftoa(steps)// &
              ' steps of dt: each frame is written at the end of the first step past its time, up to '// &
              'dt late (run.pvd gives each its own time); an interval of a whole number of steps '// &
