@@ -9,7 +9,7 @@ module casca_run
   use casca_sanity, only: check_deck
   use casca_scene, only: build_model, initial_state, tracked_nodes, scene_contact
   use casca_starter, only: put_warnings, spring_time, deck_warnings
-  use casca_model, only: model_t, reference_state, dof
+  use casca_model, only: model_t, reference_state, dof, follower_loaded
   use casca_assembly, only: assembly_setup
   use casca_mass_solver, only: mass_setup
   use casca_start_acceleration, only: loaded_acceleration
@@ -206,6 +206,7 @@ contains
       if (deck%run%newton_tol /= unset) r%opts%tol = deck%run%newton_tol
       r%opts%max_iter = deck%run%newton_max_iter
       r%opts%reuse = deck%run%reuse_factorisation
+      r%opts%linear = deck%run%linear
       allocate (r%fext(model%ndof))
       call gravity_load(model, r%fext)
       r%fext = r%fext + model%fext
@@ -226,9 +227,9 @@ contains
       if (r%restart /= '') then   ! (statics: t is the load factor, <= 1)
         call load_checkpoint(r%restart, model, merge(1._dp, deck%run%t_end, deck%run%analysis == &
                              'static'), deck%run%max_step_cuts, r%st, r%level, r%err, r%contact, &
-                             r%dt_try, cap, r%bal%pressure_path)
+                             r%dt_try, cap, r%bal%path_work)
         if (failed(r, 'restart')) return
-        r%bal%q_path = r%st%q   ! (the pressures' work on open surfaces goes on from here)
+        r%bal%q_path = r%st%q   ! (the open pressures' and moments' work goes on from here)
         r%dt_cap = cap(1); r%cap_since = cap(2); r%made_last = cap(3)
         r%restart_step = r%st%step
       end if
@@ -494,12 +495,14 @@ contains
 
   !> Statics: load steps of the dead loads; one history row and frame per load step
   !> (t = load factor), a checkpoint at every multiple of checkpoint_interval (of the load
-  !> factor); a restart goes on from the checkpoint's load step.
+  !> factor); a restart goes on from the checkpoint's load step. A linear analysis is one
+  !> step, one solve.
   subroutine static_run(r)
     type(run_t), intent(inout) :: r
-    integer :: i, stabilised, sig
+    integer :: i, stabilised, sig, nsteps
     real(dp) :: next_ckpt
     associate (deck => r%deck, st => r%st)
+      nsteps = merge(1, deck%run%load_steps, deck%run%linear)
       next_ckpt = huge(1._dp)
       if (deck%output%checkpoint_interval > 0) &
         next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
@@ -507,13 +510,13 @@ contains
         call account_state(r, factor=0._dp)
         if (.not. row_and_frame(r, 0)) return
       end if
-      do i = st%step + 1, deck%run%load_steps
-        call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/deck%run%load_steps, &
+      do i = st%step + 1, nsteps
+        call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/nsteps, &
                           deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, stabilised, r%contact)
         if (allocated(r%err)) then
           call give_up(r, r%err%message); return
         end if
-        st%t = real(i, dp)/deck%run%load_steps; st%step = i
+        st%t = real(i, dp)/nsteps; st%step = i
         call account_state(r, factor=st%t)   ! (issue 17)
         call watch_thickness(r)
         call watch_faces(r)
@@ -522,10 +525,10 @@ contains
           '  factor', st%t, '  newton', r%rep%iters, &
           trim(merge('  stabilised', '            ', stabilised > 0))
         sig = stop_requested()
-        if (sig > 0 .and. i < deck%run%load_steps) then
+        if (sig > 0 .and. i < nsteps) then
           call stop_on_request(r, sig); return
         end if
-        if (st%t >= next_ckpt - 1e-9_dp .and. i < deck%run%load_steps) then
+        if (st%t >= next_ckpt - 1e-9_dp .and. i < nsteps) then
           call checkpoint(r)
           if (r%code /= exit_ok) return
           next_ckpt = next_multiple(st%t, deck%output%checkpoint_interval)
@@ -790,7 +793,7 @@ contains
           ground(b) = any(model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7)))
           falls(b) = any(bd%gravity /= 0) .and. .not. ground(b)
           loaded(b) = any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0) .or. &
-                      any(model%pressure(bd%elem_first:bd%elem_last) /= 0)
+                      follower_loaded(model, b)
         end associate
       end do
       if (allocated(r%contact)) then
@@ -1019,7 +1022,7 @@ contains
     call r%ls%drop_factors()
     call output_flush(r%out, e)   ! the history up to this step, for a restart from here
     if (.not. allocated(e)) call save_checkpoint(r%dir//'/checkpoint.h5', r%model, r%st, r%level, &
-                                                  r%bal%pressure_path, r%contact, e, r%dt_try, &
+                                                  r%bal%path_work, r%contact, e, r%dt_try, &
                                                   [r%dt_cap, r%cap_since, r%made_last])
     call share_error(e)
     if (allocated(e)) then
@@ -1156,7 +1159,7 @@ contains
       if (deck%run%analysis /= 'static' .and. r%restart_step < 0) then
         print '(a)', balance_summary(r%bal0, r%bal, model%length, any(model%fixed) .or. &
                                      any(r%fext /= 0) .or. size(deck%obstacles) > 0 .or. &
-                                     any(model%pressure /= 0))   ! (issue 17)
+                                     any(model%pressure /= 0) .or. any(model%moment /= 0))
         print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact, corrections=.true.))
       end if
       ! the mesh indicator of the last state, per body (issue 18)

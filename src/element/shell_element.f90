@@ -299,28 +299,46 @@ contains
   !> Cauchy stress (global axes) at (xi1, xi2, xi3) of the element, for output:
   !> sigma = F S F^T / det F with F = A1 A0^-1 and S the SVK stress of the Green strain.
   !> xi3 = -1 is the bottom face, 0 the mid-surface, +1 the top face: the side the initial
-  !> fibre V points to.
-  pure function shell_stress(x0, v0, h, lam, mu, q, xi1, xi2, xi3) result(sig)
+  !> fibre V points to. With linear (a linear analysis), the stress of the strain linear in
+  !> q - q0, sym(dA1 A0^-1): the Green strain's square of each rotation would swamp it.
+  pure function shell_stress(x0, v0, h, lam, mu, q, xi1, xi2, xi3, linear) result(sig)
     real(dp), intent(in) :: x0(3, 10), v0(3, 10), h, lam, mu, q(7, 10), xi1, xi2, xi3
+    logical, intent(in), optional :: linear
     real(dp) :: sig(3, 3)
-    real(dp) :: phi(10), dphi(10, 2), a0(3, 3), f(3, 3), e(3, 3), s(3, 3), inv(3, 3), d
+    real(dp) :: phi(10), dphi(10, 2), a0(3, 3), f(3, 3), e(3, 3), s(3, 3), inv(3, 3), d, q2(7, 10)
     integer :: i
+    logical :: lin
+    lin = .false.
+    if (present(linear)) lin = linear
     call tri10_shape(xi1, xi2, phi, dphi)
     a0 = initial_jacobian(phi, dphi, x0, v0, h, xi3)
     d = det3(a0)
     inv(:, 1) = cross(a0(:, 2), a0(:, 3))/d   ! rows of A0^-1, stored as columns
     inv(:, 2) = cross(a0(:, 3), a0(:, 1))/d
     inv(:, 3) = cross(a0(:, 1), a0(:, 2))/d
-    f = matmul(current_jacobian(phi, dphi, q, h, xi3), transpose(inv))
-    e = 0.5_dp*matmul(transpose(f), f)
-    do i = 1, 3
-      e(i, i) = e(i, i) - 0.5_dp
-    end do
+    if (lin) then
+      ! A1 is quadratic in q (the fibre times the thickness parameter), so the central
+      ! difference about q0 = (X, V, 0) is exactly its part linear in q - q0
+      q2(1:3, :) = 2*x0 - q(1:3, :); q2(4:6, :) = 2*v0 - q(4:6, :); q2(7, :) = -q(7, :)
+      f = 0.5_dp*matmul(current_jacobian(phi, dphi, q, h, xi3) - current_jacobian(phi, dphi, q2, h, xi3), &
+                        transpose(inv))
+      e = 0.5_dp*(f + transpose(f))
+    else
+      f = matmul(current_jacobian(phi, dphi, q, h, xi3), transpose(inv))
+      e = 0.5_dp*matmul(transpose(f), f)
+      do i = 1, 3
+        e(i, i) = e(i, i) - 0.5_dp
+      end do
+    end if
     s = 2*mu*e
     do i = 1, 3
       s(i, i) = s(i, i) + lam*(e(1, 1) + e(2, 2) + e(3, 3))
     end do
-    sig = matmul(f, matmul(s, transpose(f)))/det3(f)
+    if (lin) then
+      sig = s
+    else
+      sig = matmul(f, matmul(s, transpose(f)))/det3(f)
+    end if
   end function shell_stress
 
   !> The faces' metrics at the element's nodes before it moves: m0(:, k, l) = the dot products

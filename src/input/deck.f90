@@ -1,12 +1,14 @@
 !> The input deck: a Fortran namelist file with the groups
-!>   &run        analysis, time step, end time, Newmark and Newton parameters, gravity
+!>   &run        analysis (dynamic, static, linear), time step, end time, Newmark and Newton
+!>               parameters, gravity
 !>   &output     folder, frame interval, tracked points, checkpoint interval
 !>   &body       (one per body) mesh or generator, material, thickness, initial motion
 !>   &restraint  (any number) prescribed parameters of a body's nodes: a box, a node list or
 !>               a named set (a physical group of the body's mesh file)
-!>   &load       (any number) a dead force on a body's nodes (box, list or set): shared equally
-!>               ('nodal') or a uniform line load on the selected boundary edge ('edge'); or a
-!>               follower pressure on the elements whose nodes are all selected ('pressure')
+!>   &load       (any number) a dead force and a moment on a body's nodes (box, list or set):
+!>               shared equally ('nodal') or a uniform line load on the selected boundary edge
+!>               ('edge'); or a follower pressure on the elements whose nodes are all selected
+!>               ('pressure')
 !>   &contact    contact pairs, surfaces and tolerances
 !>   &obstacle   (any number) a rigid plane, sphere or cylinder, fixed or moving
 !> Every problem found while reading is collected (file:line: group: message) so that the
@@ -37,7 +39,9 @@ module casca_deck
 
   type :: run_cfg_t
     character(len=128) :: title = ''
-    character(len=16) :: analysis = 'dynamic'   !< 'dynamic' or 'static'
+    character(len=16) :: analysis = 'dynamic'   !< 'dynamic' or 'static' (also for 'linear')
+    logical :: linear = .false.                 !< analysis = 'linear': statics at small
+                                                !< displacements, one solve at the whole load
     real(dp) :: dt = unset, t_end = unset
     real(dp) :: beta = 1.0_dp, gamma = 1.5_dp  !< the thesis' choice for impact
     real(dp) :: rho_inf = unset                 !< given: generalized-alpha (not beta, gamma)
@@ -101,6 +105,7 @@ module casca_deck
     character(len=64) :: set = ''               !< a physical group of the body's mesh file
     character(len=16) :: kind = 'nodal'         !< 'nodal': shared equally; 'edge': line load
     real(dp) :: force(3) = 0                    !< total
+    real(dp) :: moment(3) = 0                   !< total [N m], about a fixed axis
     real(dp) :: pressure = 0                    !< kind 'pressure' [Pa], along the normal
     integer :: line = 0
   end type load_cfg_t
@@ -382,15 +387,16 @@ contains
       integer, intent(in) :: uu
       type(deck_t), intent(inout) :: dk
       character(len=long) :: body, set, kind
-      real(dp) :: box_min(3), box_max(3), force(3), pressure
+      real(dp) :: box_min(3), box_max(3), force(3), moment(3), pressure
       integer :: nodes(max_set)
-      namelist /load/ body, box_min, box_max, force, nodes, set, kind, pressure
+      namelist /load/ body, box_min, box_max, force, moment, nodes, set, kind, pressure
       type(load_cfg_t) :: l
       integer :: il
       rewind (uu)
       do il = 1, count(gname == 'load')
         l = load_cfg_t()
         body = l%body; box_min = l%box_min; box_max = l%box_max; force = l%force; nodes = 0
+        moment = l%moment
         set = l%set; kind = l%kind; pressure = l%pressure
         read (uu, nml=load, iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -402,6 +408,7 @@ contains
         call take(dk, l%line, '&load: set', set, l%set)
         call take(dk, l%line, '&load: kind', lower(kind), l%kind)
         l%box_min = box_min; l%box_max = box_max; l%force = force; l%pressure = pressure
+        l%moment = moment
         l%nodes = pack(nodes, nodes /= 0)
         dk%loads = [dk%loads, l]
       end do
@@ -503,7 +510,7 @@ contains
         call add_problem(deck, lines(j), trim(msgs(j)))
       end do
       deck%readable_problems = deck%readable_problems + unknown   ! (blanked out of text)
-      deck%key_name = [deck%key_name, keys]
+      deck%key_name = [character(len=20) :: deck%key_name, keys]
       deck%key_group_line = [deck%key_group_line, spread(gline(k), 1, size(keys))]
       deck%key_line = [deck%key_line, key_lines]
     end do
@@ -551,6 +558,9 @@ contains
       end if
       call take(deck, line, '&run: title', title, c%title)
       call take(deck, line, '&run: analysis', lower(analysis), c%analysis)
+      if (c%analysis == 'linear') then   ! (a static run in every other respect)
+        c%analysis = 'static'; c%linear = .true.
+      end if
       call take(deck, line, '&run: ordering', lower(ordering), c%ordering)
       call take(deck, line, '&run: factor_precision', lower(factor_precision), c%factor_precision)
       c%dt = dt; c%t_end = t_end; c%rho_inf = rho_inf

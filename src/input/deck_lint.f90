@@ -42,7 +42,8 @@ module casca_deck_lint
     key_t('restraint', 'box_max', 'r'), key_t('restraint', 'nodes', 'i'), &
     key_t('load', 'body', 's'), key_t('load', 'set', 's'), key_t('load', 'kind', 's'), &
     key_t('load', 'box_min', 'r'), key_t('load', 'box_max', 'r'), key_t('load', 'force', 'r'), &
-    key_t('load', 'nodes', 'i'), key_t('load', 'pressure', 'r'), key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
+    key_t('load', 'nodes', 'i'), key_t('load', 'pressure', 'r'), key_t('load', 'moment', 'r'), &
+    key_t('contact', 'pairs', 's'), key_t('contact', 'solver', 's'), &
     key_t('contact', 'normal', 's'), key_t('contact', 'surface', 's'), &
     key_t('contact', 'tolerance', 'r'), key_t('contact', 'friction', 'r'), &
     key_t('contact', 'stiffness', 'r'), &
@@ -62,7 +63,7 @@ module casca_deck_lint
 
   !> The keys that are vectors of three, in every group they belong to
   character(len=11), parameter :: vec3(*) = [character(len=11) :: 'gravity', 'rotate_axis', &
-    'center', 'velocity', 'omega', 'box_min', 'box_max', 'force', 'point', 'normal', 'axis']
+    'center', 'velocity', 'omega', 'box_min', 'box_max', 'force', 'moment', 'point', 'normal', 'axis']
 
 contains
 

@@ -59,8 +59,12 @@ contains
         if (r%tolerance /= unset) call dynamic_only('tolerance')
         if (r%tolerance_length /= unset) call dynamic_only('tolerance_length')
         if (r%rho_inf /= unset .and. r%tolerance == unset) call dynamic_only('rho_inf')   ! (else tolerance's default)
+        if (r%linear .and. deck%contact%enabled .and. (size(deck%bodies) > 1 .or. &
+            size(deck%obstacles) > 0 .or. deck%contact%npairs > 0)) call add_problem(deck, l, &
+          '&run: analysis = ''linear'' has no contact (small displacements, one solve): set '// &
+          '&contact enabled = .false. where the bodies stay apart, or use analysis = ''static''')
       case default
-        call add_problem(deck, l, '&run: analysis must be ''dynamic'' or ''static'' (got '''// &
+        call add_problem(deck, l, '&run: analysis must be ''dynamic'', ''static'' or ''linear'' (got '''// &
                          trim(r%analysis)//''')')
       end select
       if (r%newton_tol /= unset) call positive(l, '&run: newton_tol', r%newton_tol)
@@ -192,8 +196,8 @@ contains
         if (l%kind /= 'nodal' .and. l%kind /= 'edge' .and. l%kind /= 'pressure') &
           call add_problem(deck, l%line, '&load: kind = '''//trim(l%kind)// &
                            ''' (use nodal, edge or pressure)')
-        if (l%kind == 'pressure' .and. any(l%force /= 0)) call add_problem(deck, l%line, &
-          '&load: kind = ''pressure'' takes pressure = ..., not force')
+        if (l%kind == 'pressure' .and. any(l%force /= 0 .or. l%moment /= 0)) call add_problem(deck, &
+          l%line, '&load: kind = ''pressure'' takes pressure = ..., not force or moment')
         if (l%kind /= 'pressure' .and. l%pressure /= 0) call add_problem(deck, l%line, &
           '&load: pressure needs kind = ''pressure''')
         call finite(l%line, '&load: pressure', [l%pressure])
@@ -202,6 +206,7 @@ contains
         if (any(ieee_is_nan([l%box_min, l%box_max]))) call add_problem(deck, l%line, &
           '&load: box_min and box_max must be numbers (not NaN)')
         call finite(l%line, '&load: force', l%force)
+        call finite(l%line, '&load: moment', l%moment)
       end associate
     end do
     call check_memory()

@@ -1,6 +1,6 @@
 !> A scene as the solver sees it: all bodies' nodes and elements in one numbering, materials,
-!> element reference data (A0^-1, w det A0, mass), prescribed parameters, dead loads and
-!> follower pressures.
+!> element reference data (A0^-1, w det A0, mass), prescribed parameters, dead loads, follower
+!> pressures and moments.
 !> Parameters of node i are dofs 7(i-1)+1..7(i-1)+7 = [Y(3), G(3), A].
 module casca_model
   use casca_kinds, only: dp
@@ -9,12 +9,13 @@ module casca_model
   use casca_mesh, only: mesh_t, nen
   use casca_shape_tri10, only: tri10_shape, tri10_normal, tri10_node_xi
   use casca_shell_element, only: shell_rule_t, shell_rule_init, shell_reference, shell_mass, &
-                                 svk_lame, ndof_node, shell_face_stretch, &
-                                 shell_face_metric
+                                 svk_lame, ndof_node, ndof_elem, shell_face_stretch, &
+                                 shell_face_metric, shell_energy_force
   implicit none
   private
   public :: body_t, model_t, model_add_body, model_finalize, dof, element_dofs, reference_state
-  public :: area_points, thick_points, element_area, thinnest, least_face_stretch
+  public :: area_points, thick_points, element_area, thinnest, least_face_stretch, follower_loaded
+  public :: element_energy
 
   integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
   integer, parameter :: thick_points = 3
@@ -44,9 +45,16 @@ module casca_model
     real(dp), allocatable :: fext(:)         !< (ndof) dead nodal loads
     real(dp), allocatable :: pressure(:)     !< (nelem) follower pressure on each element [Pa]
     !> (nelem) the element's body's loaded elements make closed surfaces under one pressure:
-    !> its work is p (V - V0) there (casca_pressure_assembly), a sum along the path elsewhere
+    !> its work is p (V - V0) there (casca_follower_loads), a sum along the path elsewhere
     logical, allocatable :: pressure_closed(:)
-    logical :: load_stiffness = .true.       !< the pressures' load stiffness in the tangent
+    !> (3, nnode) a moment about a fixed axis on each node's fibre [N m] (casca_moment_load)
+    real(dp), allocatable :: moment(:, :)
+    !> (nnode) the element whose tangent entries carry the node's moment stiffness: the first
+    !> holding the node, so that one rank adds it
+    integer, allocatable :: moment_elem(:)
+    logical :: load_stiffness = .true.       !< the pressures' and moments' load stiffness in the tangent
+    logical :: linear = .false.              !< a linear analysis: energies and stresses of the
+                                             !< strain linear in q - q0
     real(dp) :: length = 1                   !< size of the scene (bounding-box diagonal)
   end type model_t
 
@@ -214,8 +222,47 @@ contains
     model%fixed = .false.; model%fext = 0
     allocate (model%pressure(model%nelem), model%pressure_closed(model%nelem))
     model%pressure = 0; model%pressure_closed = .false.
+    allocate (model%moment(3, model%nnode), model%moment_elem(model%nnode))
+    model%moment = 0
+    do e = model%nelem, 1, -1
+      model%moment_elem(model%conn(:, e)) = e
+    end do
     model%length = norm2(maxval(model%x0, dim=2) - minval(model%x0, dim=2))
   end subroutine model_finalize
+
+  !> Element e's strain energy at q; in a linear analysis (model%linear) 1/2 dq . K0 dq with
+  !> dq = q - q0 and K0 the element's stiffness unstressed, the energy of the linear strains
+  !> (the Green strain's would count the square of each rotation)
+  function element_energy(model, q, e) result(w)
+    type(model_t), intent(in) :: model
+    real(dp), intent(in) :: q(:)
+    integer, intent(in) :: e
+    real(dp) :: w
+    real(dp) :: qe(ndof_node, nen), q0(ndof_node, nen), fe(ndof_elem), ke(ndof_elem, ndof_elem), d(ndof_elem)
+    qe = reshape(q(element_dofs(model, e)), [ndof_node, nen])
+    associate (b => model%body(model%elem_body(e)))
+      if (.not. model%linear) then
+        call shell_energy_force(model%rule, b%thickness, b%lam, b%mu, model%binv(:, :, :, e), &
+                                model%wdet(:, e), qe, .false., w, fe, ke, want_f=.false.)
+        return
+      end if
+      q0(1:3, :) = model%x0(:, model%conn(:, e)); q0(4:6, :) = model%v0(:, model%conn(:, e)); q0(7, :) = 0
+      call shell_energy_force(model%rule, b%thickness, b%lam, b%mu, model%binv(:, :, :, e), &
+                              model%wdet(:, e), q0, .true., w, fe, ke)
+    end associate
+    d = reshape(qe - q0, [ndof_elem])
+    w = 0.5_dp*dot_product(d, matmul(ke, d))
+  end function element_energy
+
+  !> Body b carries a load that depends on its state: a follower pressure or a moment
+  pure logical function follower_loaded(model, b)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    associate (bd => model%body(b))
+      follower_loaded = any(model%pressure(bd%elem_first:bd%elem_last) /= 0) .or. &
+                        any(model%moment(:, bd%node_first:bd%node_last) /= 0)
+    end associate
+  end function follower_loaded
 
   !> q of the unstressed initial state: Y = X, G = V, A = 0.
   pure subroutine reference_state(model, q)

@@ -76,7 +76,7 @@ contains
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
     integer, intent(in) :: level
-    real(dp), intent(in) :: pressure_work   !< on open surfaces so far (balance_t%pressure_path)
+    real(dp), intent(in) :: pressure_work   !< of open pressures and moments so far (balance_t%path_work)
     type(contact_t), intent(in), optional :: contact
     type(error_t), allocatable, intent(out) :: err
     real(dp), intent(in), optional :: dt_next   !< the next step (error-controlled runs)

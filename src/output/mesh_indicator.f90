@@ -86,14 +86,15 @@ contains
   !> mask the membrane and bending jumps the indicator is about.
   !> The distance through the thickness is the initial one, h/2 xi3: both sides of an edge use
   !> the same definition, which is what the jump needs.
-  pure function resultants(x0, v0, h, lam, mu, q, xi1, xi2, zt, wt) result(r)
+  pure function resultants(x0, v0, h, lam, mu, q, xi1, xi2, zt, wt, linear) result(r)
     real(dp), intent(in) :: x0(3, 10), v0(3, 10), h, lam, mu, q(7, 10), xi1, xi2, zt(:), wt(:)
+    logical, intent(in) :: linear   !< a linear analysis' stress (shell_stress)
     real(dp) :: r(nr)
     real(dp) :: sig(3, 3), n(3, 3), m(3, 3), p(3, 3), nv(3), phi(10), dphi(10, 2)
     integer :: k
     n = 0; m = 0
     do k = 1, size(zt)
-      sig = shell_stress(x0, v0, h, lam, mu, q, xi1, xi2, zt(k))
+      sig = shell_stress(x0, v0, h, lam, mu, q, xi1, xi2, zt(k), linear)
       n = n + (0.5_dp*h*wt(k))*sig
       m = m + (0.25_dp*h*h*wt(k)*zt(k))*sig
     end do
@@ -127,8 +128,9 @@ contains
   !> One element: R at the ng points (gt, gw on [0, 1]) of each edge, the length weights ds
   !> there (w |dX/dt|, initial mid-surface), and int_e |R|^2 dA and A_e by the area rule
   !> (axi, aw). Allocation-free: the caller holds every array.
-  pure subroutine element_terms(x0, v0, h, lam, mu, q, zt, wt, gt, gw, axi, aw, redge, ds, rr, area)
+  pure subroutine element_terms(x0, v0, h, lam, mu, q, zt, wt, gt, gw, axi, aw, linear, redge, ds, rr, area)
     real(dp), intent(in) :: x0(3, 10), v0(3, 10), h, lam, mu, q(7, 10), zt(:), wt(:), gt(ng), gw(ng)
+    logical, intent(in) :: linear
     real(dp), intent(in) :: axi(:, :), aw(:)
     real(dp), intent(out) :: redge(nr, ng, 3), ds(ng, 3), rr, area
     real(dp) :: xi(2), dxi(2), phi(10), dphi(10, 2), r(nr), ja
@@ -138,14 +140,14 @@ contains
         call edge_point(j, gt(g), xi, dxi)
         call tri10_shape(xi(1), xi(2), phi, dphi)
         ds(g, j) = gw(g)*norm2(matmul(x0, dphi(:, 1)*dxi(1) + dphi(:, 2)*dxi(2)))
-        redge(:, g, j) = resultants(x0, v0, h, lam, mu, q, xi(1), xi(2), zt, wt)
+        redge(:, g, j) = resultants(x0, v0, h, lam, mu, q, xi(1), xi(2), zt, wt, linear)
       end do
     end do
     rr = 0; area = 0
     do g = 1, size(aw)
       call tri10_shape(axi(1, g), axi(2, g), phi, dphi)
       ja = aw(g)*norm2(tri10_normal(x0, dphi))
-      r = resultants(x0, v0, h, lam, mu, q, axi(1, g), axi(2, g), zt, wt)
+      r = resultants(x0, v0, h, lam, mu, q, axi(1, g), axi(2, g), zt, wt, linear)
       area = area + ja
       rr = rr + ja*sum(r*r)
     end do
@@ -203,7 +205,7 @@ contains
       call element_terms(model%x0(:, nodes), model%v0(:, nodes), model%body(b)%thickness, &
                          model%body(b)%lam, model%body(b)%mu, &
                          reshape(q(element_dofs(model, e)), [7, 10]), zt, wt, gt, gw, axi, aw, &
-                         redge(:, :, :, e), ds(:, :, e), rr(e), area(e))
+                         model%linear, redge(:, :, :, e), ds(:, :, e), rr(e), area(e))
     end do
     do e = 1, model%nelem
       et2(e) = eta2(e, nbr, nedge, same, redge, ds, area)

@@ -10,7 +10,7 @@ module casca_output
   use, intrinsic :: iso_fortran_env, only: int64
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_model, only: model_t, dof, element_dofs
+  use casca_model, only: model_t, dof, element_dofs, element_energy
   use casca_newmark, only: state_t
   use casca_accounting, only: balance_t
   use casca_shell_element, only: shell_stress, von_mises, shell_energy_force, ndof_elem
@@ -468,11 +468,12 @@ contains
       x0 = model%x0(:, nodes); v0 = model%v0(:, nodes)
       qe = reshape(q(element_dofs(model, e)), [7, 10])
       do k = 1, 3
-        sig = shell_stress(x0, v0, h, lam, mu, qe, 1._dp/3, 1._dp/3, xi3(k))
+        sig = shell_stress(x0, v0, h, lam, mu, qe, 1._dp/3, 1._dp/3, xi3(k), model%linear)
         cell(:, e, k) = symmetric_components(sig)
         vm(1, e, k) = von_mises(sig)
         do l = 1, 10
-          sig = shell_stress(x0, v0, h, lam, mu, qe, tri10_node_xi(1, l), tri10_node_xi(2, l), xi3(k))
+          sig = shell_stress(x0, v0, h, lam, mu, qe, tri10_node_xi(1, l), tri10_node_xi(2, l), xi3(k), &
+                             model%linear)
           node(:, nodes(l), k) = node(:, nodes(l), k) + symmetric_components(sig)
         end do
       end do
@@ -492,14 +493,10 @@ contains
   function cell_energy(model, q) result(w)
     type(model_t), intent(in) :: model
     real(dp), intent(in) :: q(:)
-    real(dp) :: w(1, model%nelem), fe(ndof_elem), ke(ndof_elem, ndof_elem)
-    integer :: e, b
+    real(dp) :: w(1, model%nelem)
+    integer :: e
     do e = 1, model%nelem
-      b = model%elem_body(e)
-      call shell_energy_force(model%rule, model%body(b)%thickness, model%body(b)%lam, &
-                              model%body(b)%mu, model%binv(:, :, :, e), model%wdet(:, e), &
-                              reshape(q(element_dofs(model, e)), [7, 10]), .false., w(1, e), fe, ke, &
-                              want_f=.false.)
+      w(1, e) = element_energy(model, q, e)
     end do
   end function cell_energy
 

@@ -169,15 +169,38 @@ contains
         do n = 1, size(sel)
           model%fext(dof(sel(n), 1):dof(sel(n), 3)) = model%fext(dof(sel(n), 1):dof(sel(n), 3)) &
                                                       + share(n)*l%force
+          model%moment(:, sel(n)) = model%moment(:, sel(n)) + share(n)*l%moment
         end do
+        call check_drilling(deck, l%line, model, sel)
       end associate
     end do
     do k = 1, model%nbody
       model%body(k)%gravity = deck%run%gravity + deck%bodies(k)%gravity
     end do
-    model%load_stiffness = deck%run%load_stiffness
+    ! (a linear analysis' tangent is the stiffness unstressed: no load stiffness)
+    model%load_stiffness = deck%run%load_stiffness .and. .not. deck%run%linear
+    model%linear = deck%run%linear
     call closed_pressures(model)
   end subroutine build_model
+
+  !> A shell node has no rotation about its fibre: a moment with a part along a loaded node's
+  !> fibre (beyond 1%, round-off of nodal normals on a curved edge) is refused, naming it
+  subroutine check_drilling(deck, line, model, sel)
+    type(deck_t), intent(inout) :: deck
+    integer, intent(in) :: line, sel(:)
+    type(model_t), intent(in) :: model
+    real(dp) :: m(3)
+    integer :: k, n
+    do k = 1, size(sel)
+      n = sel(k); m = model%moment(:, n)
+      if (abs(dot_product(m, model%v0(:, n))) <= 1e-2_dp*norm2(m)) cycle
+      call add_problem(deck, line, '&load: moment: node '//itoa(n - model%body(model%node_body(n))%node_first + 1)// &
+        ' of body "'//model%body(model%node_body(n))%name//'" takes '//vtoa(m)// &
+        ' N m, with a part along its normal '//vtoa(model%v0(:, n))// &
+        ': a shell carries no moment about its normal (drilling); give the moment across it')
+      return
+    end do
+  end subroutine check_drilling
 
   !> a thickness above half its body's size is no shell: a length in another unit (2 for
   !> 0.002 on a ball of 0.05 m weighed 66 t and ran). Judged on the mesh, before the elements

@@ -187,6 +187,12 @@ contains
     end do
     do k = 1, size(deck%bodies)   ! (a run stops at the first load step: no equilibrium)
       if (any(deck%restraints(:)%body == deck%bodies(k)%name)) cycle
+      if (deck%run%linear) then
+        w = [character(len=400) :: w, 'body '''//trim(deck%bodies(k)%name)//''' has no '// &
+          '&restraint: a linear analysis solves K0 u = f, singular for a body free to move: '// &
+          'restrain its rigid motion (loads that balance each other: 3-2-1, at three nodes)']
+        cycle
+      end if
       w = [character(len=400) :: w, 'body '''//trim(deck%bodies(k)%name)//''' has no '// &
         '&restraint: in statics only contacts can hold it against the loads, and if none '// &
         'does from the first load step there is no equilibrium to find (loads that balance '// &

@@ -1,13 +1,13 @@
 !> Energy and momentum of a state: kinetic energy, strain energy, work of the dead loads and
 !> of the follower pressures (p (V - V0) on closed surfaces, a sum along the states on open
-!> ones: casca_pressure_assembly),
+!> ones) and of the moments (a sum along the states: casca_follower_loads),
 !> linear and angular momentum, all from the constant consistent mass (no lumping); kinetic
 !> and strain energy also per body, the totals being their sums.
 module casca_accounting
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t, strain_energy_local
-  use casca_pressure_assembly, only: pressure_work_local, pressure_path_local
+  use casca_follower_loads, only: pressure_work_local, follower_path_local
   use casca_newmark, only: state_t
   use casca_mpi, only: sum_all
   use casca_vectors, only: cross
@@ -24,10 +24,11 @@ module casca_accounting
     !> (two bodies thrown at each other, a body spinning in place)
     real(dp) :: p_bodies = 0
     real(dp), allocatable :: body_kinetic(:), body_strain(:)   !< (nbody); kinetic, strain: sums
-    !> the pressures' work on open surfaces at load factor 1, summed from q0 along the states
+    !> the work at load factor 1 of the pressures on open surfaces and of the moments, summed
+    !> from q0 along the states
     !> accounted (one straight segment each) to q_path: carried from state to state (and in the
     !> checkpoint), as it is no function of the state
-    real(dp) :: pressure_path = 0
+    real(dp) :: path_work = 0
     real(dp), allocatable :: q_path(:)
   end type balance_t
 
@@ -44,11 +45,12 @@ contains
 
   !> fext: the dead load; q0: the state where its work is zero; factor: the pressures'
   !> load factor (statics; default 1); bal: the balance of the state accounted before (its
-  !> pressure_path, q_path; none: from q0), overwritten with st's. The pressures' work is
-  !> factor times their work at factor 1 along the path, as the dead loads' fext . (q - q0) at
-  !> the current factor in statics: p (V - V0) on a closed surface (the pressure is
-  !> conservative there: exact, restart-proof), and on an open one, whose p (V - V0) depends
-  !> on the origin, the sum over the segments from state to state (pressure_path_local).
+  !> path_work, q_path; none: from q0), overwritten with st's. The pressures' and moments'
+  !> work is factor times their work at factor 1 along the path, as the dead loads' fext .
+  !> (q - q0) at the current factor in statics: p (V - V0) on a closed surface (the pressure
+  !> is conservative there: exact, restart-proof), and on an open one, whose p (V - V0)
+  !> depends on the origin, and for a moment, whose angle is known modulo 2 pi, the sum over
+  !> the segments from state to state (follower_path_local).
   subroutine account(model, asm, st, fext, q0, bal, factor)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(in) :: asm
@@ -68,9 +70,9 @@ contains
     if (present(factor)) lf = factor
     s(2*nb + 4) = pressure_work_local(model, asm%owned, st%q, q0, lf)
     if (.not. allocated(bal%q_path)) then
-      bal%pressure_path = 0; bal%q_path = q0
+      bal%path_work = 0; bal%q_path = q0
     end if
-    s(5*nb + 5) = pressure_path_local(model, asm%owned, bal%q_path, st%q)
+    s(5*nb + 5) = follower_path_local(model, asm%owned, bal%q_path, st%q)
     call strain_energy_local(model, asm, st%q, s(nb + 1:2*nb))
     do i = 1, size(asm%owned)   ! every body: frozen ones move too
       e = asm%owned(i)
@@ -91,8 +93,8 @@ contains
     bal%l = s(2*nb + 1:2*nb + 3)
     bal%p = sum(reshape(s(2*nb + 5:5*nb + 4), [3, nb]), dim=2)
     bal%p_bodies = sum(sqrt(2*model%body(:)%mass*s(1:nb)))
-    bal%pressure_path = bal%pressure_path + s(5*nb + 5); bal%q_path = st%q
-    bal%work = dot_product(fext, st%q - q0) + s(2*nb + 4) + lf*bal%pressure_path
+    bal%path_work = bal%path_work + s(5*nb + 5); bal%q_path = st%q
+    bal%work = dot_product(fext, st%q - q0) + s(2*nb + 4) + lf*bal%path_work
     bal%total = bal%kinetic + bal%strain - bal%work
   contains
     !> the 20 vector parameters (Y^l, G^l) of element e from a full-length vector

@@ -14,7 +14,7 @@
 module casca_assembly
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_model, only: model_t, element_dofs
+  use casca_model, only: model_t, element_dofs, element_energy
   use casca_shell_element, only: shell_energy_force, ndof_elem
   use casca_mpi, only: my_rank, n_ranks, sum_all, bcast_int, is_root
   use casca_metis, only: partition_elements
@@ -313,17 +313,12 @@ contains
     type(assembly_t), intent(in) :: asm
     real(dp), intent(in) :: q(:)
     real(dp), intent(out) :: energy(:)   !< (nbody)
-    real(dp) :: fe(ndof_elem), ke(ndof_elem, ndof_elem), ue   ! ke: not touched
     integer :: i, e, b
     energy = 0
     do i = 1, size(asm%dealt)
       e = asm%dealt(i)
       b = model%elem_body(e)
-      call shell_energy_force(model%rule, model%body(b)%thickness, model%body(b)%lam, &
-                              model%body(b)%mu, model%binv(:, :, :, e), model%wdet(:, e), &
-                              reshape(q(element_dofs(model, e)), [7, 10]), .false., ue, fe, ke, &
-                              want_f=.false.)
-      energy(b) = energy(b) + ue
+      energy(b) = energy(b) + element_energy(model, q, e)
     end do
   end subroutine strain_energy_local
 

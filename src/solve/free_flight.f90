@@ -5,7 +5,7 @@
 !> just that and leaves its parameters out of the equations (docs/method.md).
 module casca_free_flight
   use casca_kinds, only: dp
-  use casca_model, only: model_t, dof
+  use casca_model, only: model_t, dof, follower_loaded
   use casca_contact, only: contact_t, face_reach
   use casca_obstacle, only: obstacle_point
   implicit none
@@ -27,7 +27,7 @@ contains
       associate (bd => model%body(b))
         f = dof(bd%node_first, 1); l = dof(bd%node_last, 7)
         idle(b) = .not. any(model%fixed(f:l)) .and. all(fext(f:l) == 0) .and. all(qdd(f:l) == 0)
-        idle(b) = idle(b) .and. all(model%pressure(bd%elem_first:bd%elem_last) == 0)   ! (issue 17)
+        idle(b) = idle(b) .and. .not. follower_loaded(model, b)
         shift = q(dof(bd%node_first, 1):dof(bd%node_first, 3)) - model%x0(:, bd%node_first)
         v = qd(dof(bd%node_first, 1):dof(bd%node_first, 3))
         do n = bd%node_first, bd%node_last

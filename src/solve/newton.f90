@@ -32,7 +32,7 @@ module casca_newton
   use casca_strings, only: itoa
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t, assemble
-  use casca_pressure_assembly, only: add_pressure   ! follower pressure (issue 17)
+  use casca_follower_loads, only: add_follower_loads   ! pressures and moments
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
                                  kkt_solve, negative_pivots, follow_bodies
   use casca_contact, only: contact_t, constraint_t, slip
@@ -70,6 +70,8 @@ module casca_newton
     real(dp) :: force_tol = 1e-6_dp   !< residual / scene force
     integer :: max_iter = 25
     logical :: reuse = .true.         !< keep factorisations while they converge fast enough
+    logical :: linear = .false.       !< one increment with the tangent at the start (a linear
+                                      !< analysis from the unstressed state)
   end type newton_opts_t
 
   type :: newton_report_t
@@ -123,7 +125,7 @@ contains
     integer :: it, it_set, nc, version
     integer :: set_start   !< the first increment of the current active set
     integer :: follow_start   !< the iteration after which the sliding directions followed the slip
-    real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' force scale (issue 17)
+    real(dp) :: fref, ffloor, rnorm, fpress   ! fpress: the pressures' and moments' force scale
     real(dp) :: taken(max_hist)   !< rep%incr before any line-search shortening
     logical :: fresh, refresh_next
 
@@ -154,7 +156,7 @@ contains
       call timer_start(t_assembly)
       call assemble(model, asm, q, fresh, r, rep%energy, cm, qs, qn, af)
       r = r - fext
-      call add_pressure(model, asm, q, fresh, r, fpress, load_factor, qn, af)   ! pressure (issue 17)
+      call add_follower_loads(model, asm, q, fresh, r, fpress, load_factor, qn, af)
       call timer_stop(t_assembly)
       call full_residual()
       if (it > 1) then   ! (judged before factorising: an iterate left is not factorised)
@@ -172,6 +174,10 @@ contains
       end if
       call take_increment()
       if (allocated(err)) exit
+      if (opts%linear) then   ! (K0 dq = f: the linear answer, whatever the residual left)
+        rep%converged = .true.; rep%force_scale = fref
+        return
+      end if
       if (refresh_next) cycle   ! (the increment was undone)
       ! (a new rule for the sliding directions: the residual's change is not the increment's)
       if (slip_rule_changed(it, settling(rep, set_start), follow_start, contact)) inc%set = -1

@@ -8,7 +8,7 @@ module casca_start_acceleration
   use casca_error, only: error_t
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t, assemble
-  use casca_pressure_assembly, only: add_pressure
+  use casca_follower_loads, only: add_follower_loads
   use casca_mass_solver, only: mass_solver_t, mass_setup
   implicit none
   private
@@ -35,7 +35,7 @@ contains
     allocate (r(model%ndof), a(model%ndof))
     call assemble(model, asm, q, .false., r, energy)
     r = r - fext
-    call add_pressure(model, asm, q, .false., r, scale)
+    call add_follower_loads(model, asm, q, .false., r, scale)
     if (present(ms)) then
       m => ms
     else

@@ -82,6 +82,11 @@ contains
       ! 55 s more with it at every halving, and a hemisphere under its whole load in one
       ! step, whose whole step was too far for it, stopped at 1/16 of the load where its half
       ! step took it, as two load steps did)
+      if (allocated(err) .and. opts%linear) then   ! (one solve; a singular K0 stays singular)
+        err%message = 'the linear solve failed (K0 singular: a body free to move, or a mechanism?): '// &
+                      err%message
+        return
+      end if
       if (allocated(err) .and. (tries == 0 .or. (tries == 1 .and. level == 1))) then
         iters = iters + rep%iters; tries = tries + 1
         deallocate (err)

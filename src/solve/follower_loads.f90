@@ -1,31 +1,35 @@
-!> The follower pressure of the model's loaded elements (model%pressure) in Newton's
-!> residual and tangent, and its work for the energy accounting. The elements are split
-!> over the ranks as casca_assembly splits them: the force is summed over the ranks and each
-!> rank adds the load stiffness to its own elements' matrix entries.
-module casca_pressure_assembly
+!> The loads that depend on the state, in Newton's residual and tangent and in the energy
+!> accounting: the follower pressure of the model's loaded elements (model%pressure) and the
+!> moments on nodes' fibres (model%moment). The elements are split over the ranks as
+!> casca_assembly splits them: the pressure's force is summed over the ranks and each rank
+!> adds the load stiffness to its own elements' matrix entries; a moment's stiffness goes
+!> into its node's block of one element (model%moment_elem).
+module casca_follower_loads
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_assembly, only: assembly_t
   use casca_shell_element, only: ndof_elem, ndof_node
   use casca_pressure_load, only: pressure_force, pressure_volume
-  use casca_mpi, only: sum_all
+  use casca_moment_load, only: moment_force, moment_turn
+  use casca_mpi, only: sum_all, is_root
   implicit none
   private
-  public :: add_pressure, pressure_work_local, pressure_path_local
+  public :: add_follower_loads, pressure_work_local, follower_path_local
 
 contains
 
-  !> r -= factor f_p(q) and, with want_k, asm%a -= factor sym(K_p): the pressure is an
+  !> r -= factor (f_p(q) + f_m(q)) and, with want_k, asm%a -= factor (sym(K_p) + K_m): the
+  !> moments' (add_moments) and the pressure's. The pressure is an
   !> external load at the current iterate, r = f_int - f_ext. The element load stiffness K_p
   !> is unsymmetric, but over a closed surface (or one whose boundary is held) the assembled
   !> one is symmetric: the element's skew part is a boundary integral that cancels between
   !> neighbours (exactly on flat elements; to the area rule's accuracy on curved ones, where
   !> the rule does not integrate it exactly). casca's matrices are symmetric (MUMPS takes the lower triangle), so the
   !> element's symmetric part is added. scale: the largest entry of factor f_p on the free
-  !> parameters, the load's share of the scene's force scale (0 without pressure).
+  !> parameters, the loads' share of the scene's force scale (0 without them).
   !> The elements are those assemble used for the same want_k (collective: every rank calls).
   !> Without model%load_stiffness the tangent is left as it is (to show what it is worth).
-  subroutine add_pressure(model, asm, q, want_k, r, scale, factor, qn, af)
+  subroutine add_follower_loads(model, asm, q, want_k, r, scale, factor, qn, af)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
     real(dp), intent(in) :: q(:)
@@ -43,7 +47,7 @@ contains
     logical :: stiff
 
     scale = 0
-    if (all(model%pressure == 0)) return
+    if (all(model%pressure == 0) .and. all(model%moment == 0)) return
     lf = 1
     if (present(factor)) lf = factor
     stiff = want_k .and. model%load_stiffness
@@ -53,6 +57,7 @@ contains
     if (w /= 0) qa = qa + w*qn
     allocate (fp(model%ndof))
     fp = 0
+    if (any(model%moment /= 0)) call add_moments(model, asm, qa, stiff, lf, 1 - w, fp)
     if (want_k) then
       elems = asm%elems
     else
@@ -81,12 +86,49 @@ contains
     r = r - fp
     scale = maxval(abs(fp), mask=.not. model%fixed, dim=1)
     scale = max(scale, 0._dp)   ! (every parameter fixed: maxval of nothing)
-  end subroutine add_pressure
+  end subroutine add_follower_loads
+
+  !> The moments' loads on the fibres at qa, factor lf, into fp, this rank's share (the root's:
+  !> fp is summed over the ranks); with stiff, -lf wk K_m into the entries of each node's
+  !> fibre block in its moment_elem, where this rank assembles that element (wk: the share of
+  !> the end state in qa, 1 - alpha_f)
+  subroutine add_moments(model, asm, qa, stiff, lf, wk, fp)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    real(dp), intent(in) :: qa(:), lf, wk
+    logical, intent(in) :: stiff
+    real(dp), intent(inout) :: fp(:)
+    real(dp) :: f(3), k(3, 3)
+    integer :: i, e, n, p, row, col, l
+    if (is_root()) then
+      do n = 1, model%nnode
+        if (all(model%moment(:, n) == 0)) cycle
+        call moment_force(lf*model%moment(:, n), qa(dof(n, 4):dof(n, 6)), f, k)
+        fp(dof(n, 4):dof(n, 6)) = fp(dof(n, 4):dof(n, 6)) + f
+      end do
+    end if
+    if (.not. stiff) return
+    do i = 1, size(asm%elems)
+      e = asm%elems(i)
+      if (all(model%moment_elem(model%conn(:, e)) /= e)) cycle
+      do p = asm%estart(i), asm%estart(i + 1) - 1
+        row = mod(asm%pos(p) - 1, ndof_elem); col = (asm%pos(p) - 1)/ndof_elem   ! (from 0)
+        l = row/ndof_node + 1
+        if (col/ndof_node + 1 /= l) cycle   ! (a node's own block only)
+        if (mod(row, ndof_node) < 3 .or. mod(row, ndof_node) > 5 .or. &
+            mod(col, ndof_node) < 3 .or. mod(col, ndof_node) > 5) cycle   ! (its fibre's)
+        n = model%conn(l, e)
+        if (model%moment_elem(n) /= e .or. all(model%moment(:, n) == 0)) cycle
+        call moment_force(lf*model%moment(:, n), qa(dof(n, 4):dof(n, 6)), f, k)
+        asm%a(p) = asm%a(p) - wk*k(mod(row, ndof_node) - 2, mod(col, ndof_node) - 2)
+      end do
+    end do
+  end subroutine add_moments
 
   !> This rank's share of the pressures' work at q from q0 on the closed surfaces
   !> (model%pressure_closed), factor sum p (V(q) - V(q0)) over elems (pressure_volume): exact
   !> there, a function of the state; not summed over the ranks. The open surfaces' is
-  !> pressure_path_local's.
+  !> follower_path_local's.
   real(dp) function pressure_work_local(model, elems, q, q0, factor) result(w)
     type(model_t), intent(in) :: model
     integer, intent(in) :: elems(:)
@@ -104,18 +146,26 @@ contains
     w = factor*w
   end function pressure_work_local
 
-  !> This rank's share of the pressures' work at load factor 1 on the open surfaces (those
-  !> not model%pressure_closed) along the straight path from qa to qb, by Simpson's rule:
-  !> f_p is quadratic in the positions, so the rule is exact on the segment. On an open
+  !> This rank's share of the work at load factor 1 from qa to qb of the pressures on the open
+  !> surfaces (those not model%pressure_closed), along the straight path by Simpson's rule
+  !> (f_p is quadratic in the positions, so the rule is exact on the segment), and the root's
+  !> of the moments, |m| times the fibre's turn (exact for a turn below pi). On an open
   !> surface the follower pressure has no potential (p (V - V0) there depends on the
-  !> origin), so its work is this sum over the steps; not summed over the ranks.
-  real(dp) function pressure_path_local(model, elems, qa, qb) result(w)
+  !> origin), and a moment's angle is known only modulo 2 pi, so their work is this sum over
+  !> the steps; not summed over the ranks.
+  real(dp) function follower_path_local(model, elems, qa, qb) result(w)
     type(model_t), intent(in) :: model
     integer, intent(in) :: elems(:)
     real(dp), intent(in) :: qa(:), qb(:)
     real(dp) :: ya(3, 10), yb(3, 10), fa(3, 10), fm(3, 10), fb(3, 10), k(3, 10, 3, 10)
-    integer :: i, e
+    integer :: i, e, n
     w = 0
+    if (is_root()) then
+      do n = 1, model%nnode
+        if (any(model%moment(:, n) /= 0)) w = w + norm2(model%moment(:, n))* &
+          moment_turn(model%moment(:, n), qa(dof(n, 4):dof(n, 6)), qb(dof(n, 4):dof(n, 6)))
+      end do
+    end if
     do i = 1, size(elems)
       e = elems(i)
       if (model%pressure(e) == 0 .or. model%pressure_closed(e)) cycle
@@ -126,7 +176,7 @@ contains
       call pressure_force(model%rule, model%pressure(e), yb, .false., fb, k)
       w = w + sum((yb - ya)*(fa + 4*fm + fb))/6
     end do
-  end function pressure_path_local
+  end function follower_path_local
 
   !> the positions Y of element e's 10 nodes from a full-length vector
   pure subroutine element_positions(model, q, e, y)
@@ -139,4 +189,4 @@ contains
       y(:, l) = q(dof(model%conn(l, e), 1):dof(model%conn(l, e), 3))
     end do
   end subroutine element_positions
-end module casca_pressure_assembly
+end module casca_follower_loads
