@@ -150,6 +150,16 @@ backspin   the same hoop thrown at 2 m/s with 10 rad/s of backspin (its contact 
            measured 2.6%). (Before 2026-11-28 it stopped at 47 ms, 'the contact active set did
            not settle': its edge nodes stuck, slipped, were released and taken again one batch
            per decision; stick/slip turns no longer count among a step's twelve decisions.)
+near_limit statics near Coulomb's limit (a validator's scene): a free plate (1 x 1 m, 4 x 4 cells,
+           h 10 mm, E 1 GPa) on a rigid plane under -1000 Pa (N = 1000 N), pushed sideways by
+           T = 290 N (nodal shares: 0.967 mu N), mu 0.3, 10 load steps ramping both loads (T / N
+           the same at each): it runs, and at every load step the plane's friction force is T
+           and its normal force N, both times the load factor (1e-6, Newton's force tolerance):
+           nothing else holds the plate. (Before 2026-11-29 it stopped at load factor 0.306,
+           'Newton iteration diverged', and at 0.114 with 40 load steps: each increment's sliding
+           nodes took the direction of its slip, an elastic creep of up to 3e-7 m and at some
+           nodes against their force, into the next increment, and fewer nodes stayed stuck at
+           each until none held the plate.)
 bad input  static_friction below friction, a negative friction, a negative friction_decay:
            exit 2 naming the field.
 symmetry   statics with friction where symmetry restraints pass through the contact (a helper's
@@ -166,7 +176,7 @@ import sys
 
 import numpy as np
 
-from casca_testlib import Checks, angular_drift, history, momentum_error, run, run_scene
+from casca_testlib import Checks, angular_drift, history, loaded, momentum_error, run, run_scene
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
 os.makedirs(work, exist_ok=True)
@@ -546,6 +556,24 @@ if out is not None:
     ck.close("symmetry: the vertical diameter's shortening against (pi/4 - 2/pi) P R^3 / (E I)",
              shortening, (np.pi / 4 - 2 / np.pi) * 0.05 / ei, 5e-3)
 
+# statics near Coulomb's limit: a free plate pressed on a plane and pushed sideways at 0.967 mu N
+T_NL, N_NL = 290.0, 1000.0
+out, _ = run_scene(casca, ck, work, "near_limit", f"""&run analysis = 'static' /
+&output plots = .false., vtu = .false. /
+&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 4, ny = 4,
+  young = 1.0e9, poisson = 0.3, density = 1000.0, thickness = 0.01 /
+&load body = 'plate', kind = 'pressure', pressure = {-N_NL} /
+&load body = 'plate', force = {T_NL}, 0.0, 0.0 /
+&obstacle name = 'floor', shape = 'plane', point = 0.0, 0.0, -0.005, normal = 0.0, 0.0, 1.0 /
+&contact friction = 0.3 /
+""")
+if out is not None:
+    h = loaded(history(out))
+    ck.le("near_limit: T = 0.967 mu N, the plane's friction force vs T t, largest relative difference",
+          np.max(np.abs(h["ftangent_plate_floor"] / (T_NL * h["t"]) - 1)), 1e-6)
+    ck.le("near_limit: the plane's normal force vs N t, largest relative difference",
+          np.max(np.abs(h["fcontact_plate_floor"] / (N_NL * h["t"]) - 1)), 1e-6)
+    ck.record("near_limit: all 10 load steps", len(h["t"]) == 10 and abs(h["t"][-1] - 1) < 1e-12)
 
 for name, fr, needles in (("static_friction below friction", "friction = 0.3, static_friction = 0.2",
                            ["&contact", "static_friction", "below"]),

@@ -105,7 +105,8 @@ contains
         deallocate (err)
         cycle
       end if
-      if (present(contact)) call friction_step_done(contact, newmark_scheme(0._dp, 1._dp), before)
+      if (present(contact)) call friction_step_done(contact, newmark_scheme(0._dp, 1._dp), before, &
+                                                    static=.true.)   ! (s kept: friction_step_done)
       at = at + step
       if (level > 0 .and. rep%iters <= 4) level = level - 1   ! Newton is at ease: grow back
     end do
