@@ -32,7 +32,10 @@ inside sphere  a ball (R 0.05, h 2 mm) 0.1 m off the centre of a spherical conta
                wall (casca before 2026-11-29 printed its nearest node's gap over its closing
                speed: 21.3 ms for 18.6).
 self-contact   the ring's pair with itself: time to contact 'never' (its rigid motion closes no gap).
-rim edge-on    a plate (h_a 20 mm, 1 m square, 2 x 2 cells) in z = 0 and a finer plate (h_b 10 mm,
+rim edge-on    (with one pass the check also warns that a's edge, thinner than b's node spacing
+               sqrt(0.4 x 0.5 / 13^2) = 0.034401 m, can pass between b's nodes: both figures to
+               1e-4; no such warning with two passes)
+               a plate (h_a 20 mm, 1 m square, 2 x 2 cells) in z = 0 and a finer plate (h_b 10 mm,
                0.4 x 0.5 m, 4 x 4 cells, the impactor) standing in x = 1.1, its mid row of nodes
                at z = 0, moving at (-2, 0, 0) m/s: its nodes meet plate a's rim, rounded by h_a/2
                all round, with their own face h_b/2 along x: gap 0.1 - h_b/2 - h_a/2 = 0.085 m,
@@ -73,6 +76,9 @@ LINE = re.compile(r"pair '([^']*)' -> '([^']*)'[^:]*: gap\s+(\S+) m, closing spe
                   r"time to contact (never|\S+ s)")
 
 
+STDERR = {}
+
+
 def check(name, text):
     """run casca check on the deck text: {(impactor, target): (gap, speed, time or None)}"""
     deck = os.path.join(work, name + ".nml")
@@ -80,6 +86,7 @@ def check(name, text):
         f.write(text)
     p = run([casca, "check", deck])
     ck.record("%s: casca check exit 0" % name, p.returncode == 0, p.stderr[-300:])
+    STDERR[name] = p.stderr
     pairs = {}
     for m in LINE.finditer(p.stdout):
         t = None if m.group(5) == "never" else float(m.group(5).split()[0])
@@ -216,7 +223,19 @@ for passes, gap in ((1, 0.1 - 0.005 - 0.01), (2, 0.1 - 0.005 - 0.01 * 3 / 16)):
     close("rim met edge-on, passes = %d: gap [m]" % passes, ba[0], gap)
     if passes == 1:
         close("rim met edge-on, passes = 1: time to contact [s]", ba[2], gap / 2.0)
+    # the edge (h_a 20 mm) is thinner than b's node spacing, sqrt(0.4 x 0.5 / 13^2) = 0.034401 m
+    m = re.search(r"'b' -> 'a': the contact foreseen first is at the target's free edge.*?thinner "
+                  r"\((\S+) m\) than the impactor's node spacing \(about (\S+) m\)", STDERR["rim_edge_on_%d" % passes])
+    if passes == 1:
+        ck.record("rim met edge-on, passes = 1: warned that the edge can pass between b's nodes", m is not None,
+                  STDERR["rim_edge_on_1"][-400:])
+        if m:
+            close("rim met edge-on, passes = 1: the warning's edge thickness [m]", float(m.group(1)), 0.02, 1e-4)
+            close("rim met edge-on, passes = 1: the warning's node spacing [m]", float(m.group(2)),
+                  math.sqrt(0.4 * 0.5 / 13**2), 1e-4)
     else:   # (b's nodes move along a's plane: a's rim nodes meet b's face)
+        ck.record("rim met edge-on, passes = 2: no warning of an edge passing between nodes", m is None,
+                  STDERR["rim_edge_on_2"][-400:])
         ck.record("rim met edge-on, passes = 2: b's nodes meet no face of a: 'never'", ba[2] is None, str(ba))
         close("rim met edge-on, passes = 2: a's nodes meet b's face at [s]",
               got.get(("a", "b"), (None,) * 3)[2], gap / 2.0)

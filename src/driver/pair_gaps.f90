@@ -44,6 +44,8 @@ module casca_pair_gaps
     real(dp) :: speed = 0           !< closing speed at that closest approach [m/s]
     real(dp) :: time = -1           !< time to contact, the earliest node's [s]; < 0: never
     integer :: node = 0             !< the impactor node of the closest approach
+    !> the earliest time is a node's meeting the target's free edge edge-on (one pass)
+    logical :: rim = .false.
   end type pair_gap_t
 
 contains
@@ -91,7 +93,7 @@ contains
                   if (abs(tn - tl) <= 1e-13_dp*tl) exit
                 end do
               end if
-              call note(r, n, gap, speed, tn)
+              call note(r, n, gap, speed, tn, .false.)
             end do
           end associate
         else
@@ -142,7 +144,7 @@ contains
                 tl = closing_time(gap, speed, vmax)
                 if (tl >= 0 .and. (tn < 0 .or. tl < tn)) tn = tl
               end if
-              call note(r, n, gap, speed, tn)
+              call note(r, n, gap, speed, tn, rounded)
             end do
             deallocate (lo, hi, vm, gm)
           end associate
@@ -153,16 +155,19 @@ contains
     end do
   end function pair_gaps
 
-  !> node n's gap, closing speed and time to contact tn (< 0: none): the pair's smallest gap
-  !> and its earliest time
-  pure subroutine note(r, n, gap, speed, tn)
+  !> node n's gap, closing speed and time to contact tn (< 0: none; rim: at the target's rim
+  !> edge-on): the pair's smallest gap and its earliest time
+  pure subroutine note(r, n, gap, speed, tn, rim)
     type(pair_gap_t), intent(inout) :: r
     integer, intent(in) :: n
     real(dp), intent(in) :: gap, speed, tn
+    logical, intent(in) :: rim
     if (gap < r%gap) then
       r%gap = gap; r%node = n; r%speed = speed
     end if
-    if (tn >= 0 .and. (r%time < 0 .or. tn < r%time)) r%time = tn
+    if (tn >= 0 .and. (r%time < 0 .or. tn < r%time)) then
+      r%time = tn; r%rim = rim
+    end if
   end subroutine note
 
   !> gap over closing speed; -1 unless it closes faster than rounding of the bodies' speeds

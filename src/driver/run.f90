@@ -43,7 +43,7 @@ module casca_run
   use casca_run_state, only: run_t, progress_t, exit_ok, exit_input, exit_solver, exit_signal, cap_hold, &
                              newton_share, newton_floor
   use casca_run_watch, only: watch_energy, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, &
-                             rest_now, step_judged, warn_dynamic, balance_terms, moving_obstacles
+                             rest_now, made_judged, warn_dynamic, balance_terms, moving_obstacles
   implicit none
   private
   public :: load_scene, run_deck, exit_ok, exit_input
@@ -315,15 +315,15 @@ contains
         if (r%sc%tol > 0 .and. guarded) then
           if (in_contact()) then
             r%dt_cap = huge(1._dp); r%made_last = 0
-          else if (step_judged(r)) then
-            if (.not. energy_accepted(r, made, energy_scale())) then
+          else
+            if (.not. energy_accepted(r, made_judged(r, made), energy_scale())) then
               call undo_step()
               cycle
             end if
           end if
         end if
-        if (guarded .and. .not. energy_cut .and. step_judged(r) .and. &
-            made > made_limit*energy_scale() .and. may_cut()) then
+        if (guarded .and. .not. energy_cut .and. made_judged(r, made) > made_limit*energy_scale() .and. &
+            may_cut()) then
           why = 'the step made '//ftoa(100*made/energy_scale())//'% of the energy the '// &
                 'bodies hold (a node deep into a target, or a mode the step cannot follow)'
           call undo_step()   ! (after the share: undone, the step's end is its start)
@@ -813,6 +813,7 @@ contains
         falls = falls .and. moves
         loaded = loaded .and. moves
         r%held_at_start = any(held)
+        r%held_g2 = sum(model%body(:)%mass*[(sum(model%body(b)%gravity**2), b=1, model%nbody)], mask=held)
         if (r%held_at_start) call start_carry(r%contact, near, -weights(model, held), ground)
       end if
       do b = 1, model%nbody

@@ -74,9 +74,11 @@ module casca_run_state
     real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
     integer :: made_contacts = 0
     integer :: made_between = 0                 !< of them, between bodies (not obstacles)
-    !> a body under gravity starts held by its contact (a = 0): its first step makes energy
-    !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact: not watched
+    !> bodies under gravity start held by their contacts (a = 0): the first step makes energy
+    !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact; held_g2:
+    !> their sum of m |g|^2 [kg m^2/s^4], so that m g^2 dt^2 of that step is not judged
     logical :: held_at_start = .false.
+    real(dp) :: held_g2 = 0
     !> the least stretches the run's states reached, through the thickness and along the
     !> faces, where and when (watch_thickness, watch_faces)
     type(least_t) :: thick, face

@@ -203,7 +203,9 @@ contains
       rep%neg_pivots = negative_pivots(ls, asm, nc)
       return
     end do
-    if (.not. allocated(err)) call fatal_error(err, failure_message(rep, rnorm, fref))
+    if (.not. allocated(err)) call fatal_error(err, failure_message(rep, rnorm, fref, &
+      rep%nincr > 0 .and. small_enough(rep, step_tol(opts%tol, q, model%length, qn)) .and. &
+      rnorm <= max(opts%force_tol*fref, ffloor)))
     q = q_entry
     if (present(contact)) then
       contact%set%nact = size(act_entry)
@@ -546,15 +548,19 @@ contains
     call timer_stop(t_solve)
   end subroutine solve_increment
 
-  function failure_message(rep, rnorm, fref) result(msg)
+  function failure_message(rep, rnorm, fref, within) result(msg)
     type(newton_report_t), intent(in) :: rep
     real(dp), intent(in) :: rnorm, fref
+    logical, intent(in) :: within   !< the last iterate was within Newton's tolerances
     character(len=:), allocatable :: msg
     character(len=160) :: buf
     write (buf, '(a,i0,a,es9.2,a,es9.2,a)') 'Newton did not converge in ', rep%iters, &
       ' iterations (last increment ', rep%incr(max(rep%nincr, 1)), &
       ' of the scene size, residual ', rnorm/max(fref, tiny(1._dp)), ' of the scene force)'
     msg = trim(buf)
+    ! (both figures below the tolerances read as a contradiction to a validator)
+    if (within) msg = msg//': its iterates were within the tolerances, but the contacts kept '// &
+                      'changing (constraints taken or let go, or nodes turning between stick and slip)'
     ! (newton_max_iter is each active set's; a reader of 100 looked for a 100 in the deck)
     if (rep%iters >= max_hist) msg = msg//'; '//itoa(max_hist)//' is the most a step takes '// &
                                      'over all its active sets'
