@@ -15,7 +15,7 @@ module casca_accounting
   implicit none
   private
   public :: balance_t, energy_term_t, account, gravity_load, balance_summary, energy_balance, &
-            balance_remainder
+            balance_remainder, energy_put
 
   type :: balance_t
     real(dp) :: kinetic = 0, strain = 0, work = 0, total = 0
@@ -194,8 +194,21 @@ contains
       end do
     end if
     line = line//', removed by the time integrator and contact '//rtoa(rest)
-    ! (a share of all the energy put in: of E0 alone, a plate dropped onto a floor under
-    ! gravity had 102% of it removed)
+    call energy_put(b0, b, extra, put, what)
+    if (abs(rest) < 1e6_dp*put) then   ! (not of an E0 that is zero or nearly)
+      line = line//' ('//ftoa(100*rest/put)//'% of '//what//')'
+    end if
+  end function energy_balance
+
+  !> All the energy put in by state b, what the remainder is a share of, and its name: E0,
+  !> the loads' work when positive, the sources' (of E0 alone, a plate dropped onto a floor
+  !> under gravity had 102% of it removed)
+  pure subroutine energy_put(b0, b, extra, put, what)
+    type(balance_t), intent(in) :: b0, b
+    type(energy_term_t), intent(in), optional :: extra(:)
+    real(dp), intent(out) :: put
+    character(len=:), allocatable, intent(out) :: what
+    integer :: k
     put = abs(b0%total) + max(b%work, 0._dp)
     what = 'E0'
     if (b%work > 0) what = 'E0 and the loads'' work'
@@ -206,8 +219,5 @@ contains
         end if
       end do
     end if
-    if (abs(rest) < 1e6_dp*put) then   ! (not of an E0 that is zero or nearly)
-      line = line//' ('//ftoa(100*rest/put)//'% of '//what//')'
-    end if
-  end function energy_balance
+  end subroutine energy_put
 end module casca_accounting
