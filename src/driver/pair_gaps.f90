@@ -29,7 +29,7 @@ module casca_pair_gaps
   use casca_kinds, only: dp
   use casca_model, only: model_t, dof
   use casca_obstacle, only: obstacle_point, obstacle_ray_time
-  use casca_closest_point, only: closest_point_triangle
+  use casca_closest_point, only: closest_point_triangle, region_edge_ab, region_vertex_a
   use casca_contact, only: contact_t, tested_both_ways
   use casca_contact_projection, only: face, positions, on_rim
   use casca_surface_search, only: surface_t
@@ -44,7 +44,8 @@ module casca_pair_gaps
     real(dp) :: speed = 0           !< closing speed at that closest approach [m/s]
     real(dp) :: time = -1           !< time to contact, the earliest node's [s]; < 0: never
     integer :: node = 0             !< the impactor node of the closest approach
-    !> the earliest time is a node's meeting the target's free edge edge-on (one pass)
+    !> the earliest time is a node's meeting the target's free edge coming edge-first (one
+    !> pass: edge_first)
     logical :: rim = .false.
   end type pair_gap_t
 
@@ -144,7 +145,7 @@ contains
                 tl = closing_time(gap, speed, vmax)
                 if (tl >= 0 .and. (tn < 0 .or. tl < tn)) tn = tl
               end if
-              call note(r, n, gap, speed, tn, rounded)
+              call note(r, n, gap, speed, tn, rounded .and. edge_first(s, x, best_tri, best_region, vt - v(:, n)))
             end do
             deallocate (lo, hi, vm, gm)
           end associate
@@ -154,6 +155,32 @@ contains
       end associate
     end do
   end function pair_gaps
+
+  !> The target's rim at the nearest point (region of sub-triangle it of s) advances on the
+  !> node, relative velocity w, edge-first: w within 60 degrees of the rim's outward normal
+  !> in the sub-triangle's plane (at a vertex, of its rim edges' summed). Not so for rings
+  !> closing face to face, their rim nodes level, nor sliding along each other's rims, which
+  !> are nearest at the rim too.
+  pure logical function edge_first(s, x, it, region, w)
+    type(surface_t), intent(in) :: s
+    real(dp), intent(in) :: x(:, :), w(3)
+    integer, intent(in) :: it, region
+    real(dp) :: nrm(3), m(3), o(3), v(3, 3)
+    integer :: e, k
+    v = x(:, s%tri(:, it))
+    nrm = cross(v(:, 2) - v(:, 1), v(:, 3) - v(:, 1))
+    m = 0
+    do e = 1, 3   ! (edges ab, bc, ca: from vertex e to the next)
+      k = mod(e, 3) + 1
+      if (.not. s%rim(e, it)) cycle
+      if (.not. (region == region_edge_ab + e - 1 .or. region == region_vertex_a + e - 1 .or. &
+                 region == region_vertex_a + k - 1)) cycle
+      o = cross(v(:, k) - v(:, e), nrm)
+      if (dot_product(o, v(:, mod(k, 3) + 1) - v(:, e)) > 0) o = -o   ! (away from the third)
+      m = m + o/norm2(o)
+    end do
+    edge_first = dot_product(w, m) > 0.5_dp*norm2(w)*norm2(m) .and. norm2(m) > 0
+  end function edge_first
 
   !> node n's gap, closing speed and time to contact tn (< 0: none; rim: at the target's rim
   !> edge-on): the pair's smallest gap and its earliest time
