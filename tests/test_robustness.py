@@ -12,8 +12,12 @@ shipped      every deck in examples/ runs to its end with exit 0 (ball_bounce: i
              other deck is run here, from a copy: today that is cantilever.nml (statics, Sze's
              cantilever under end shear), whose tip deflections at P = 4 are compared with Sze,
              Liu & Lo (2004), hoop_rolling.nml (exit 0 here; its physics, the same scene, is
-             asserted in test_friction.py) and ball_bounce.nml (compliant contact; its order
-             through contact is asserted on a plate in test_compliant_contact.py).
+             asserted in test_friction.py), ball_bounce.nml (compliant contact; its order
+             through contact is asserted on a plate in test_compliant_contact.py) and
+             rollup.nml (Sze's test 3.2, the cantilever rolled into a circle by an end moment:
+             the tip against the exact arc x = sin(kL)/k, z = (1 - cos kL)/k, k = M / E I, at
+             every load step within 0.5% of L; at M_max the strain energy M^2 L / (2 E I) and
+             the moment's work 2 pi M within 1%).
 slit         statics with large rotations from the default Newton settings: Sze's slit annular
              plate under an end line force (test 3.3), built here (tests/data/
              make_slit_annular_plate.py), 40 load steps; W_A and W_B at q = 0.2, 0.4 and 0.8
@@ -209,6 +213,24 @@ if "shipped" in CASES:
                      6.698, 0.01)
             ck.close("cantilever: tip -U at P = 4 vs Sze et al. 2004 (3.286)", 10.0 - h["p1_x"][-1],
                      3.286, 0.01)
+        if d == "rollup" and ok:
+            # Sze, Liu & Lo (2004), test 3.2: the strip (L = 12, b = 1, h = 0.1, E = 1.2e6,
+            # nu = 0) under an end moment up to M_max = 2 pi E I / L. A uniform moment bends an
+            # Euler-Bernoulli beam into an arc of curvature k = M / E I (exact here: nu = 0,
+            # one cell across): the tip at x = sin(kL)/k, z = (1 - cos kL)/k at each of the 20
+            # load factors within 0.5% of L; at M_max the strain energy M^2 L / (2 E I) and the
+            # moment's work 2 pi M (the tip turned once round) within 1% (the work is summed
+            # from the fibres' turns, so a wrong angle shows there)
+            ei = 1.2e6 * 0.1**3 / 12
+            m_max = 2 * np.pi * ei / 12.0
+            k = h["t"][1:] * m_max / ei
+            ck.le("rollup: largest |x_tip - sin(kL)/k| over the load steps, of L",
+                  np.abs(h["p1_x"][1:] - np.sin(k * 12) / k).max() / 12, 0.005)
+            ck.le("rollup: largest |z_tip - (1 - cos(kL))/k| over the load steps, of L",
+                  np.abs(h["p1_z"][1:] - (1 - np.cos(k * 12)) / k).max() / 12, 0.005)
+            ck.close("rollup: strain energy at M_max vs M^2 L / (2 E I)", h["strain"][-1],
+                     m_max**2 * 12 / (2 * ei), 0.01)
+            ck.close("rollup: the moment's work at M_max vs 2 pi M", h["work"][-1], 2 * np.pi * m_max, 0.01)
         if d == "ball_bounce" and ok:
             # an elastic ball on an elastic (compliant) floor: nothing but the scheme takes
             # energy out, and nothing may put any in
