@@ -64,7 +64,9 @@ torque    a moment load (&load moment; the shipped examples/rollup.nml, Sze's ca
           the energy balance kinetic + strain - work stays at its start within 1e-3 of the
           moment's work (the midpoint rule's drift under a nonlinear load; measured 1.6e-5).
           The same deck with the moment (0, 50, 3) N m, 6% of it along the strip's normal z:
-          exit 2, the message names the deck's line of the &load and the word drilling.
+          exit 2, the message names the deck's line of the &load and the word drilling. And
+          `casca check` of it under the thesis' Newmark (no rho_inf) warns that the fibres
+          start at the acceleration of their rotary inertia; with rho_inf it does not.
 """
 
 import os
@@ -250,5 +252,14 @@ hd, pd, dd = run_deck("drilling", TORQUE.replace("moment = 0.0, 50, 0.0", "momen
 line = TORQUE.splitlines().index([l for l in TORQUE.splitlines() if l.startswith("&load")][0]) + 1
 ck.record("drilling: a moment along the normal is refused (exit 2, %s:%d, 'drilling')" % (dd, line),
           pd.returncode == 2 and ("%s:%d:" % (dd, line)) in pd.stderr and "drilling" in pd.stderr, pd.stderr[-300:])
+
+for name, text, warned in (("thesis_newmark", TORQUE.replace(", rho_inf = 1.0", ""), True),
+                           ("midpoint", TORQUE, False)):
+    deck = os.path.join(work, "moment_" + name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text)
+    p = run([casca, "check", deck])
+    ck.record("moment under the %s: exit 0, %s of the fibres' rotary inertia" % (name, "warned" if warned else "no word"),
+              p.returncode == 0 and ("rotary inertia" in p.stderr) == warned, p.stderr[-300:])
 
 ck.finish()
