@@ -20,7 +20,7 @@ module casca_contact
   public :: contact_t, contact_options_t, active_set_t, constraint_t, target_geometry_t
   public :: contact_init, face_reach, search_radius
   public :: contact_set_stiffness, normal_compliance, normal_residual, holds, tested_both_ways
-  public :: new_constraint, slip_followed
+  public :: new_constraint, slip_followed, set_restore
 
   !> Most nodes a target normal depends on (the elements around its element's 10 nodes:
   !> about 70 on a mesh of valence 6); a constraint with more leaves its lever out
@@ -323,6 +323,14 @@ contains
     if (c%follow_slip .and. a%grip == slip) &
       slip_followed = norm2(a%ut) >= c%opt%slip_floor .and. norm2(a%ut) > 0 .and. dot_product(a%ut, a%s0) > 0
   end function slip_followed
+
+  !> The active set back to the constraints act it held (kept when a solve or a step began)
+  pure subroutine set_restore(set, act)
+    type(active_set_t), intent(inout) :: set
+    type(constraint_t), intent(in) :: act(:)
+    set%nact = size(act)
+    set%act(1:size(act)) = act
+  end subroutine set_restore
 
   !> Whether the active set holds a constraint of node on pair p
   pure logical function holds(set, node, p)

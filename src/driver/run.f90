@@ -207,6 +207,9 @@ contains
       r%opts%max_iter = deck%run%newton_max_iter
       r%opts%reuse = deck%run%reuse_factorisation
       r%opts%linear = deck%run%linear
+      if (r%opts%linear) then   ! (K0 u = f: the first increment is the answer, whatever it leaves)
+        r%opts%tol = 1e100_dp; r%opts%force_tol = 1e100_dp; r%opts%max_iter = 1
+      end if
       allocate (r%fext(model%ndof))
       call gravity_load(model, r%fext)
       r%fext = r%fext + model%fext

@@ -27,8 +27,10 @@ contains
     real(dp), intent(in) :: rest   !< the balance's remainder now (rest_now)
     type(contact_t), intent(in), optional :: start   !< the contact at the step's start
     real(dp), intent(in), optional :: h_before   !< the step before's length if it was free, else 0
-    if (made_judged(r, r%rest_last - rest) > r%made_max) then
-      r%made_max = made_judged(r, r%rest_last - rest); r%t_made = r%st%t; r%dt_made = r%nm%dt
+    real(dp) :: made
+    made = made_judged(r, r%rest_last - rest)
+    if (made > r%made_max) then
+      r%made_max = made; r%t_made = r%st%t; r%dt_made = r%nm%dt
       r%dt_made_before = 0
       if (present(h_before) .and. r%sc%tol <= 0) then   ! (fixed steps, grown back after cuts)
         if (h_before > 0 .and. r%nm%dt > 1.5_dp*h_before) r%dt_made_before = h_before
@@ -166,9 +168,11 @@ contains
     type(run_t), intent(in) :: r
     real(dp) :: rest, put
     character(len=:), allocatable :: what
+    type(energy_term_t), allocatable :: terms(:)
     if (r%restart_step >= 0) return
-    rest = balance_remainder(r%bal0, r%bal, balance_terms(r%deck, r%contact, corrections=.true.))
-    call energy_put(r%bal0, r%bal, balance_terms(r%deck, r%contact, corrections=.true.), put, what)
+    terms = balance_terms(r%deck, r%contact, corrections=.true.)
+    rest = balance_remainder(r%bal0, r%bal, terms)
+    call energy_put(r%bal0, r%bal, terms, put, what)
     if (r%e_scale > 2*put) then   ! (a run started at rest whose loads did little work yet)
       put = r%e_scale; what = 'the most energy the bodies held'
     end if

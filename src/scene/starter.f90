@@ -458,19 +458,18 @@ contains
           'finds a node: a node can cross the target unseen; dt below '// &
           rtoa(band/pg(p)%speed)//' s keeps it in')
       end if
+      ! (only the impactor's nodes are held off the other surface)
       if (bt > 0 .and. deck%contact%surface == 'faces' .and. .not. tested_both_ways(c, bi, bt)) then
-        ! (the rim is held off only at the impactor's nodes: a blade dropped edge-first between
-        ! a finer plate's node rows passed through it with no contact, exit 0)
+        ! (a blade dropped edge-first between a finer plate's node rows passed through it with
+        ! no contact, exit 0)
         if (pg(p)%rim .and. sqrt(area_per_node(model, bi)) > model%body(bt)%thickness) &
           call add(w, label//': the contact foreseen first is at the target''s free edge, met '// &
                    'edge-on, and only the impactor''s nodes are held off it: an edge thinner ('// &
                    rtoa(model%body(bt)%thickness)//' m) than the impactor''s node spacing (about '// &
                    rtoa(sqrt(area_per_node(model, bi)))//' m) can pass between them, through '// &
                    'the impactor unseen; passes = 2 holds the edge''s own nodes off its face')
-      end if
-      if (bt > 0 .and. deck%contact%surface == 'faces') then
         ratio = area_per_node(model, bi)/area_per_node(model, bt)
-        if (ratio > clearly .and. .not. tested_both_ways(c, bi, bt)) &
+        if (ratio > clearly) &
           call add(w, label//': the target''s nodes are '//rtoa(ratio)//' times denser '// &
                    '(area per node) than the impactor''s, and only the impactor''s are held off '// &
                    'the other surface: the target''s may pass between them; list the pair '// &

@@ -99,7 +99,7 @@ contains
     logical, intent(in) :: stiff
     real(dp), intent(inout) :: fp(:)
     real(dp) :: f(3), k(3, 3)
-    integer :: i, e, n, p, row, col, l
+    integer :: i, e, n, p, row, col, l, nk
     if (is_root()) then
       do n = 1, model%nnode
         if (all(model%moment(:, n) == 0)) cycle
@@ -108,6 +108,7 @@ contains
       end do
     end if
     if (.not. stiff) return
+    nk = 0   ! (the node whose k is at hand: its block's entries follow each other)
     do i = 1, size(asm%elems)
       e = asm%elems(i)
       if (all(model%moment_elem(model%conn(:, e)) /= e)) cycle
@@ -119,7 +120,8 @@ contains
             mod(col, ndof_node) < 3 .or. mod(col, ndof_node) > 5) cycle   ! (its fibre's)
         n = model%conn(l, e)
         if (model%moment_elem(n) /= e .or. all(model%moment(:, n) == 0)) cycle
-        call moment_force(lf*model%moment(:, n), qa(dof(n, 4):dof(n, 6)), f, k)
+        if (n /= nk) call moment_force(lf*model%moment(:, n), qa(dof(n, 4):dof(n, 6)), f, k)
+        nk = n
         asm%a(p) = asm%a(p) - wk*k(mod(row, ndof_node) - 2, mod(col, ndof_node) - 2)
       end do
     end do

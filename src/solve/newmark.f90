@@ -8,7 +8,7 @@ module casca_newmark
   use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t, constraint_t, holds
+  use casca_contact, only: contact_t, constraint_t, holds, set_restore
   use casca_contact_correction, only: contact_correction, add_impulses
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
@@ -87,9 +87,7 @@ contains
     released = [constraint_t ::]
     call attempt(warm=.false.)
     if (allocated(err)) then   ! (newton restores the set itself; the correction may not)
-      if (present(contact)) then
-        contact%set%nact = size(before); contact%set%act(1:size(before)) = before
-      end if
+      if (present(contact)) call set_restore(contact%set, before)
       return
     end if
     ! (a compliant contact's force falls to zero with its gap before it is released)
@@ -105,7 +103,7 @@ contains
         iters = rep%iters
         call attempt(warm=.true.)
         if (allocated(err)) then   ! (the state is as it was: the step is cut)
-          contact%set%nact = size(before); contact%set%act(1:size(before)) = before
+          call set_restore(contact%set, before)
           return
         end if
         rep%iters = rep%iters + iters

@@ -35,7 +35,7 @@ module casca_newton
   use casca_follower_loads, only: add_follower_loads   ! pressures and moments
   use casca_linear_system, only: linear_system_t, rows_t, analyse_blocks, factorise_blocks, &
                                  kkt_solve, negative_pivots, follow_bodies
-  use casca_contact, only: contact_t, constraint_t, slip
+  use casca_contact, only: contact_t, constraint_t, slip, set_restore
   use casca_contact_active_set, only: contact_update, contact_settle, contact_solve_start
   use casca_contact_friction, only: friction_hold
   use casca_contact_rows, only: contact_rows, contact_generalized_force, contact_newton_nrows, &
@@ -70,8 +70,8 @@ module casca_newton
     real(dp) :: force_tol = 1e-6_dp   !< residual / scene force
     integer :: max_iter = 25
     logical :: reuse = .true.         !< keep factorisations while they converge fast enough
-    logical :: linear = .false.       !< one increment with the tangent at the start (a linear
-                                      !< analysis from the unstressed state)
+    logical :: linear = .false.       !< a linear analysis: one increment from the unstressed
+                                      !< state, accepted by tolerances that take any (casca_run)
   end type newton_opts_t
 
   type :: newton_report_t
@@ -174,10 +174,6 @@ contains
       end if
       call take_increment()
       if (allocated(err)) exit
-      if (opts%linear) then   ! (K0 dq = f: the linear answer, whatever the residual left)
-        rep%converged = .true.; rep%force_scale = fref
-        return
-      end if
       if (refresh_next) cycle   ! (the increment was undone)
       ! (a new rule for the sliding directions: the residual's change is not the increment's)
       if (slip_rule_changed(it, settling(rep, set_start), follow_start, contact)) inc%set = -1
@@ -207,10 +203,7 @@ contains
       rep%nincr > 0 .and. small_enough(rep, step_tol(opts%tol, q, model%length, qn)) .and. &
       rnorm <= max(opts%force_tol*fref, ffloor)))
     q = q_entry
-    if (present(contact)) then
-      contact%set%nact = size(act_entry)
-      contact%set%act(1:size(act_entry)) = act_entry
-    end if
+    if (present(contact)) call set_restore(contact%set, act_entry)
   contains
 
     !> the active constraints at q (with reproject, their points projected again; new

@@ -26,7 +26,7 @@ module casca_statics
   use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
-  use casca_contact, only: contact_t, constraint_t
+  use casca_contact, only: contact_t, constraint_t, set_restore
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
   use casca_time_scheme, only: newmark_scheme
@@ -195,9 +195,7 @@ contains
     end if
     rep%iters = iters
     q = q_entry
-    if (present(contact)) then
-      contact%set%nact = size(act_entry); contact%set%act(1:size(act_entry)) = act_entry
-    end if
+    if (present(contact)) call set_restore(contact%set, act_entry)
   contains
     !> From the stabilised state, Newton without the stabilising force: the equilibrium
     !> exactly, where it is regular (settled), and rep is its report. Where it is not
