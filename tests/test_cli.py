@@ -17,6 +17,8 @@ Asserted about the command line itself (issue 17):
   geometry (ring ceil(2 pi R / H) x ceil(W / H) cells, sphere 20 ceil(R / (H sin 72 deg))^2
   triangles, plate ceil(A / H) x ceil(B / H) cells, two triangles a cell), also when counts
   are given beside it; a size that is not a positive number exits 2 naming --size;
+  `casca mesh ring --radius 1e40` exits 2 with the mesh reader's bound ("below 1e15 m") and
+  writes no file (the deck reader refused the mesh it wrote);
 - gnuplot's messages stay off the terminal: `casca run` of the static cantilever example (flat
   energy curves, on which gnuplot warns "empty y range") and `casca plot` of its folder exit 0
   with no "empty y range" in their stdout or stderr, and the warning is in the folder's
@@ -35,6 +37,11 @@ Asserted about the command line itself (issue 17):
 - frames with fixed steps: an interval of 12.5 steps of dt is warned of by `casca check` (with
   the ratio, 12.500) and the run, whose frames are at the first step ends at or past 0, 0.5 and
   1 ms (0, 0.52, 1.0 ms); an interval of 12 steps is not warned of.
+- text outside the groups (a group's name without its '&', stray words between groups, words
+  after a group's '/' on its line) exits 2 at its line, from `casca run` and `casca check`
+  alike (the namelist read skipped it: a restraint vanished); '!' comments and blank lines
+  between groups and after a '/' are accepted. A degenerate element is named with its body's
+  deck line and mesh file; t_end = 1e300 is shown as 1.0000E+300 (was 1.0000+300).
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -148,6 +155,12 @@ for bad in ("-0.1", "big"):
     p = run([casca, "mesh", "sphere", "--size", bad, "-o", os.path.join(work, "sized.msh")])
     ck.record("casca mesh --size %s: exit 2 naming --size" % bad,
               p.returncode == 2 and "--size" in p.stderr, p.stderr.strip())
+# (it was written, and a deck naming it refused it)
+huge_msh = os.path.join(work, "huge.msh")
+p = run([casca, "mesh", "ring", "--radius", "1e40", "-o", huge_msh])
+ck.record("casca mesh ring --radius 1e40: exit 2 with the mesh reader's bound, no file written",
+          p.returncode == 2 and "node coordinates must be finite numbers of size below 1e15 m" in p.stderr
+          and not glob.glob(huge_msh + "*"), p.stderr.strip())
 
 p = run([casca, "frobnicate"])
 ck.record("unknown command: exit 2", p.returncode == 2 and "unknown command" in p.stderr)
@@ -216,6 +229,14 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["&body", "young has an empty value", ":12:"]),
     ("a vector short of a number", lambda s: s.replace("velocity = 10.0, 0.0, 0.0", "velocity = 10.0, 0.0", 1),
      ["&body", "velocity takes 3 numbers (x, y, z), 2 given", ":11:"]),
+    ("t_end far too large", lambda s: s.replace("t_end = 3.0e-3", "t_end = 1e300"), ["(got 1.0000E+300)", ":2:"]),
+    # (text outside the groups: the namelist read skipped it, a restraint vanished)
+    ("a group's name without its &", lambda s: s + "restraint\n body = 'ring2', fix = 'clamped'\n/\n",
+     ["text outside a group: 'restraint' (a group starts with &)", ":18:", "1 problem in the deck"]),
+    ("stray text between groups", lambda s: s.replace("/\n&output", "/\nthis is stray text dt = 1\n&output", 1),
+     ["text outside a group: 'this is stray text dt = 1'", ":4:"]),
+    ("text after a group's '/'", lambda s: s.replace("t_end = 3.0e-3\n/\n", "t_end = 3.0e-3\n/ t_end = 0.002\n", 1),
+     ["text after the group's closing '/': 't_end = 0.002'", ":3:"]),
     ("E not positive", lambda s: s.replace("young = 210e9", "young = -1.0", 1), ["young", "> 0"]),
     ("rho not positive", lambda s: s.replace("density = 7700", "density = 0.0", 1), ["density", "> 0"]),
     ("thickness not positive", lambda s: s.replace("thickness = 0.05", "thickness = 0.0", 1), ["thickness", "> 0"]),
@@ -228,7 +249,7 @@ cases = [  # (name, text transformation, substrings the message must hold)
      ["dt must be > 0", "poisson must be in (-1, 0.5)", "track needs 3 coordinates per point", "3 problems in the deck"]),
     ("missing mesh file", lambda s: s.replace(ring, "/no/such/ring.msh", 1), ["/no/such/ring.msh", "does not exist"]),
     ("empty mesh", lambda s: s.replace(ring, empty_msh, 1), ["empty.msh", "10-node triangles"]),
-    ("degenerate element", lambda s: s.replace(ring, flat_msh, 1), ["degenerate", "ring1"]),
+    ("degenerate element", lambda s: s.replace(ring, flat_msh, 1), ["&body ring1: %s: " % flat_msh, "degenerate", ":9:"]),
     ("quadrangles beside the triangles", lambda s: s.replace(ring, mixed_msh, 1),
      ["mixed.msh", "1 surface element that is not a 10-node triangle", "Gmsh type 3, line 35"]),
     ("restraint selects no node", lambda s: s + "&restraint\n body = 'ring2', box_min = 50.0, 50.0, 50.0, fix = 'y'\n/\n",
@@ -279,7 +300,7 @@ cases = [  # (name, text transformation, substrings the message must hold)
         "name = 'ring1', mesh = 'file', file = '%s'" % ring,
         "name = 'ring1', mesh = 'ring', radius = 1.0, width = 10.0, n_around = 8, n_across = 2", 1)
      .replace("thickness = 0.05", "thickness = 4.5", 1),
-     ['body "ring1" turns inside out through its thickness, 4.5000E+00 m']),
+     ["&body ring1: element", "turns inside out through its thickness, 4.5000E+00 m", ":9:"]),
     ("time-step keys in a static deck", lambda s: s.replace("  dt = 5.0e-5, t_end = 3.0e-3\n",
                                                             "  dt = 5.0e-5, t_end = 3.0e-3\n  analysis = 'static', tolerance = 1e-5\n", 1),
      ["&run: tolerance is for analysis = 'dynamic'; a static run steps its load by load_steps", ":3:"]),
@@ -306,12 +327,17 @@ for name, change, needles in cases:
           and "Backtrace" not in msg and "Error termination" not in msg)
     ck.record("bad deck, %s: exit 2 and a message naming it" % name, ok,
               "exit %d: %s" % (p.returncode, msg.strip().splitlines()[0] if msg.strip() else ""))
+    if "outside a group" in " ".join(needles) or "closing '/'" in " ".join(needles):
+        c = run([casca, "check", deck])
+        ck.record("bad deck, %s: casca check says the same (exit 2)" % name,
+                  c.returncode == 2 and all(n in c.stderr for n in needles), c.stderr.strip()[:200])
 ck.record("no output folder was made for bad decks", not os.path.exists(os.path.join(work, "bad_out")))
 nodeset = os.path.join(work, "nodeset.nml")
 with open(nodeset, "w") as f:
-    f.write(good + "&restraint\n body = 'ring2', nodes = 1, 2, 240, fix = 'y'\n/\n")
+    f.write(good + "\n  ! a comment between groups\n&restraint\n body = 'ring2', nodes = 1, 2, 240, fix = 'y'\n/  ! and after\n\n")
 p = run([casca, "check", nodeset])
-ck.record("a node set within range is accepted (casca check: exit 0, 3 fewer unknowns)",
+ck.record("a node set within range, with comments and blank lines between groups, is accepted "
+          "(casca check: exit 0, 3 fewer unknowns)",
           p.returncode == 0 and "3357 unknowns" in p.stdout, p.stdout.strip() + p.stderr.strip())
 
 # --- a short two-ring run: frames, collection, history in two formats

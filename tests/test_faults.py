@@ -1,7 +1,12 @@
 """casca as a hostile or unlucky user meets it (issue 15): crashes and restarts, a full disk,
 two runs in one folder, foreign checkpoints, shell injection, non-finite numbers, an error on
 one of two MPI ranks. Each case asserts exit codes and file contents against an independent
-answer (an uninterrupted run, the file system, the deck's own numbers).
+answer (an uninterrupted run, the file system, the deck's own numbers). Among them: a run
+into a finished run's folder, stopped by SIGTERM, leaves none of that run's plots (plots.gp,
+gnuplot.log, PNGs), while a restart in place keeps them; on a full disk (as root only: a
+small tmpfs is mounted, else skipped) the restart hint is printed exactly when a checkpoint is
+left, and stopped.txt, written where there is room for it (at one size at least), names the
+failed write.
 
 usage: test_faults.py CASCA MESH_DIR WORK_DIR
 """
@@ -199,6 +204,40 @@ p = run([casca, "run", deck("finished", t_end="4.0e-3", out=done_out), "-q",
 ck.record("restart from a finished run's checkpoint (t_end + rounding): exit 0, history.dat unchanged",
           p.returncode == 0 and before != "" and open(os.path.join(done_out, "history.dat")).read() == before,
           first_line(p))
+
+# --- a run into the folder of a finished run removes that run's plots (plots.gp, gnuplot.log,
+# the PNGs) as it starts: stopped (SIGTERM) early, it left them beside its own history as its
+# own (validator 2026-11-29). A restart in place carries on the history they were drawn from
+# and keeps them.
+plot_names = ["plots.gp", "gnuplot.log", "positions_x.png", "energy.png", "momentum.png", "contact.png",
+              "newton.png", "displacements.png"]
+
+
+def stopped_in(folder, extra_args=()):
+    """casca run of a 10 ms deck into folder, SIGTERM once it holds the folder's lock: exit code"""
+    proc = subprocess.Popen([casca, "run", deck("replot", out=folder), "-q"] + list(extra_args), env=ENV,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    while proc.poll() is None and not os.path.exists(os.path.join(folder, "casca.lock")):
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGTERM)
+    proc.communicate(timeout=120)
+    return proc.returncode
+
+
+had = [n for n in plot_names if os.path.exists(os.path.join(done_out, n))]
+replot_out, keep_out = os.path.join(work, "replot"), os.path.join(work, "replot_restart")
+shutil.copytree(done_out, replot_out)
+shutil.copytree(done_out, keep_out)
+code = stopped_in(replot_out)
+left = [n for n in plot_names if os.path.exists(os.path.join(replot_out, n))]
+ck.record("a new run into a finished run's folder, stopped by SIGTERM (exit 4): none of the earlier "
+          "run's plots left (it had plots.gp at least)",
+          code == 4 and "plots.gp" in had and not left,
+          "exit %d, had %s, left %s" % (code, had, left))
+code = stopped_in(keep_out, ["--restart", os.path.join(keep_out, "checkpoint.h5")])
+kept = [n for n in plot_names if os.path.exists(os.path.join(keep_out, n))]
+ck.record("a restart in place, stopped by SIGTERM (exit 4): the run's plots kept",
+          code == 4 and kept == had, "exit %d, kept %s of %s" % (code, kept, had))
 
 # --- a restart into a new folder (--out elsewhere): it carries on the checkpoint folder's
 # history, which ends as the uninterrupted run's (1e-12), and leaves the old folder as it was
@@ -434,8 +473,9 @@ else:
     mounted = m.returncode == 0
     if not mounted:
         print("SKIP full disk: mount -t tmpfs failed: " + m.stderr.strip())
+stopped_said = []
 try:
-    for size in (["100k", "200k", "300k", "600k"] if mounted else []):
+    for size in (["100k", "200k", "300k", "420k", "600k"] if mounted else []):
         out = os.path.join(disk, "o")
         shutil.rmtree(out, ignore_errors=True)
         subprocess.run(["mount", "-o", "remount,size=" + size, disk], check=True)
@@ -445,6 +485,22 @@ try:
         ck.record("disk of %s filled by the run: non-zero exit (no signal), a message" % size, ok, first_line(p))
         ck.record("disk of %s: every file under its final name complete, no .part left" % size, not bad,
                   "incomplete: %s" % bad)
+        # (README: exit 3 leaves stopped.txt; it had none, nor a restart hint)
+        ckpt = os.path.join(out, "checkpoint.h5")
+        hint = "restart: casca run %s --restart %s" % (deck("disk", t_end="3.0e-3", out=out), ckpt)
+        ck.record("disk of %s: the restart hint printed if and only if a checkpoint is left (%s)"
+                  % (size, "one is" if ckpt_step(ckpt) >= 0 else "none is"),
+                  (hint in p.stderr) == (ckpt_step(ckpt) >= 0), p.stderr.strip()[-300:])
+        stopped = os.path.join(out, "stopped.txt")
+        said = open(stopped).read() if os.path.exists(stopped) else ""
+        if said:
+            stopped_said.append(size)
+        ck.record("disk of %s: stopped.txt, if there was room for it, names the failed write" % size,
+                  not os.path.exists(stopped) or ("this run stopped at t = " in said and "disk full" in said),
+                  said[:200])
+    if mounted:
+        ck.record("a full disk left stopped.txt where there was room for it (at %s)" % stopped_said,
+                  len(stopped_said) > 0)
     if mounted:   # casca mesh writes its file the same way
         shutil.rmtree(os.path.join(disk, "o"), ignore_errors=True)   # (a tmpfs shrinks only when empty)
         subprocess.run(["mount", "-o", "remount,size=100k", disk], check=True)

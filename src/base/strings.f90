@@ -26,13 +26,19 @@ contains
     s = trim(b)
   end function itoa_i64
 
-  !> x in scientific notation with 5 significant digits, e.g. 2.4190E+04
+  !> x in scientific notation with 5 significant digits, e.g. 2.4190E+04, 1.0000E+300
   pure function rtoa(x) result(s)
     real(real64), intent(in) :: x
     character(len=:), allocatable :: s
     character(len=24) :: b
-    write (b, '(es12.4)') x
+    integer :: k
+    ! (es12.4 drops the E of a 3-digit exponent, 1.0000+300: 3 digits, the first 0 dropped)
+    write (b, '(es13.4e3)') x
     s = trim(adjustl(b))
+    k = index(s, 'E')
+    if (k > 0) then
+      if (s(k + 2:k + 2) == '0') s = s(1:k + 1)//s(k + 3:)
+    end if
   end function rtoa
 
   !> (x, y, z) of a point, each as rtoa

@@ -169,7 +169,7 @@ contains
     integer, intent(out) :: code
     type(run_t), allocatable :: r   ! (large: MUMPS structures)
     allocate (r)
-    r%quiet = quiet; r%restart = restart
+    r%quiet = quiet; r%restart = restart; r%kept = restart
     call run_setup(r, path, out_dir)
     if (r%code == exit_ok) then
       if (r%deck%run%analysis == 'static') then
@@ -995,6 +995,7 @@ contains
       if (is_root()) write (0, '(a,a,a,a)') 'error (', what, '): ', r%err%message
       r%code = exit_solver
       if (what == 'output' .or. what == 'setup' .or. what == 'restart') r%code = exit_input
+      if (r%code == exit_solver) call mark_failed(r, r%err%message)
       call output_release(r%out)
     end if
   end function failed
@@ -1032,9 +1033,36 @@ contains
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (checkpoint): ', e%message
       r%code = exit_solver
+      call mark_failed(r, e%message)   ! (the checkpoint before this one is whole: written via .part)
       call output_release(r%out)
+    else
+      r%kept = r%dir//'/checkpoint.h5'
     end if
   end subroutine checkpoint
+
+  !> An output could not be written (a full disk), the files are whole up to it: say so in
+  !> stopped.txt if it can still be written (README: exit 3 leaves one), and how to restart
+  subroutine mark_failed(r, why)
+    type(run_t), intent(inout) :: r
+    character(len=*), intent(in) :: why
+    character(len=:), allocatable :: hint, text
+    hint = restart_hint(r)
+    text = 'this run stopped '//when(r)//': '//why
+    if (hint /= '') text = text//new_line('a')//hint
+    call output_mark_stopped(r%out, text)
+    if (is_root() .and. hint /= '') write (0, '(a)') hint
+  end subroutine mark_failed
+
+  !> The command that goes on from the checkpoint r%kept ('' if none; without --out a restart
+  !> goes to the deck's folder)
+  function restart_hint(r) result(text)
+    type(run_t), intent(in) :: r
+    character(len=:), allocatable :: text
+    text = ''
+    if (r%kept == '') return
+    text = 'restart: casca run '//r%deck%path//' --restart '//r%kept
+    if (r%dir /= trim(r%deck%output%dir)) text = text//' --out '//r%dir
+  end function restart_hint
 
   !> The solver cannot go on: keep the last good state (frame and checkpoint) and stop.
   subroutine give_up(r, why)
@@ -1115,13 +1143,10 @@ contains
     call frame(r)
     call checkpoint(r)
     call r%ls%finish()
-    where_kept = 'the last good state is in '//r%dir//'/checkpoint.h5'
+    if (r%code == exit_solver) return   ! (checkpoint said why, and where a restart can start)
+    where_kept = 'the last good state is in '//r%kept
     ! (a body that nothing holds has no equilibrium to go on to, from any state)
-    if (index(reason, 'no equilibrium') == 0) then   ! (without --out a restart goes to the deck's folder)
-      where_kept = where_kept//' (restart: casca run '//r%deck%path//' --restart '//r%dir//'/checkpoint.h5'
-      if (r%dir /= trim(r%deck%output%dir)) where_kept = where_kept//' --out '//r%dir
-      where_kept = where_kept//')'
-    end if
+    if (index(reason, 'no equilibrium') == 0) where_kept = where_kept//' ('//restart_hint(r)//')'
     if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
     call output_mark_stopped(r%out, 'this run stopped '//when(r)//': '//reason//new_line('a')//where_kept)
     call output_close(r%out, e)
@@ -1142,7 +1167,8 @@ contains
     call share_error(e)
     if (allocated(e)) then
       if (is_root()) write (0, '(a,a)') 'error (output): ', e%message
-      r%code = exit_solver; return
+      r%code = exit_solver
+      call mark_failed(r, e%message); return
     end if
     if (r%deck%output%plots .and. is_root()) then
       call make_plots(r%dir, e, missing, static=r%deck%run%analysis == 'static')

@@ -94,6 +94,7 @@ module casca_run_state
     integer, allocatable :: tracked(:)
     character(len=128), allocatable :: labels(:)
     character(len=:), allocatable :: dir, restart
+    character(len=:), allocatable :: kept      !< the checkpoint a restart can go on from ('': none)
     real(dp) :: t0 = 0                          !< wall time at the start
     integer :: level = 0                        !< step cuts: dt / 2**level
     integer :: restart_step = -1, total_newton = 0, code = exit_ok

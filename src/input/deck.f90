@@ -17,7 +17,7 @@ module casca_deck
   use, intrinsic :: iso_fortran_env, only: iostat_end, iostat_eor
   use casca_files, only: file_kind, kind_special, kind_folder
   use casca_kinds, only: dp
-  use casca_deck_lint, only: lint_group, lower
+  use casca_deck_lint, only: lint_group, outside_text, lower
   implicit none
   private
   public :: deck_t, run_cfg_t, output_cfg_t, body_cfg_t, restraint_cfg_t, load_cfg_t
@@ -503,6 +503,12 @@ contains
       gname = [character(len=16) :: gname, name]; gline = [gline, n]
     end do
     rewind (u)
+    ! (the namelist read skips such text: the rest of the deck reads as it would without it)
+    call outside_text(text, lines, msgs)
+    do j = 1, size(lines)
+      call add_problem(deck, lines(j), trim(msgs(j)))
+    end do
+    deck%readable_problems = deck%readable_problems + size(lines)
     allocate (deck%key_name(0), deck%key_group_line(0), deck%key_line(0))
     do k = 1, size(gname)
       call lint_group(text, gline(k), trim(gname(k)), lines, msgs, keys, key_lines, unknown)

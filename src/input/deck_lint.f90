@@ -5,7 +5,7 @@ module casca_deck_lint
   use casca_strings, only: itoa
   implicit none
   private
-  public :: lint_group, lower, did_you_mean
+  public :: lint_group, outside_text, lower, did_you_mean
 
   !> Every key of every group and its type: 'r' real, 'i' integer, 'l' logical, 's' string
   !> (the one list: the lint's check and its suggestions read it)
@@ -309,6 +309,48 @@ contains
       msgs = [character(len=512) :: msgs, msg]
     end subroutine report
   end subroutine lint_group
+
+  !> The text outside every group: a group's name written without its '&', stray words
+  !> between groups, words after a group's '/' on its line. The namelist read skips them
+  !> without a word (a restraint written 'restraint' vanished from a run); blanks and '!'
+  !> comments may stand there. Told once until the next group; a group left open is the
+  !> lint's to report (its text is skipped here).
+  subroutine outside_text(text, lines, msgs)
+    character(len=*), intent(in) :: text(:)
+    integer, allocatable, intent(out) :: lines(:)
+    character(len=512), allocatable, intent(out) :: msgs(:)
+    character(len=:), allocatable :: s, line
+    integer :: i, at, start
+    logical :: inside, after, told   !< after: in a group on this line, before its '/'
+    allocate (lines(0), msgs(0))
+    inside = .false.; told = .false.; s = ''
+    do i = 1, size(text)
+      line = text(i)(1:comment_start(text(i)) - 1)
+      if (starts_group(line)) then
+        inside = .true.; told = .false.; s = ''
+      end if
+      after = inside
+      if (inside) then   ! (its '/' is on this line if the text so far holds it, quotes aside)
+        start = len(s)
+        s = s//line//' '
+        at = group_end(s)
+        if (at <= 0) cycle
+        inside = .false.
+        line = line(at - start + 1:)
+      end if
+      if (told .or. verify(line, ' '//achar(9)) == 0) cycle
+      line = trim(adjustl(line))
+      if (len(line) > 60) line = line(1:57)//'...'
+      lines = [lines, i]; told = .true.
+      if (after) then
+        msgs = [character(len=512) :: msgs, 'text after the group''s closing ''/'': '''//line// &
+                ''' (a group ends at its ''/'')']
+      else
+        msgs = [character(len=512) :: msgs, 'text outside a group: '''//line// &
+                ''' (a group starts with &)']
+      end if
+    end do
+  end subroutine outside_text
 
   pure function kind_name(t) result(s)
     character(len=1), intent(in) :: t

@@ -23,6 +23,8 @@ module casca_gmsh_io
   !> Gmsh's triangles and quadrangles of orders 1 to 4 (MSH 2.2 gives no dimension)
   integer, parameter :: surface_types(*) = [2, 3, 9, 10, 16, 20, 21, 22, 23, 24, 36, 37, 39, 40, 41]
   real(dp), parameter :: max_coordinate = 1e15_dp   !< [m]: far beyond any scene, far below overflow
+  character(len=*), parameter :: coordinate_rule = &
+    'node coordinates must be finite numbers of size below 1e15 m'
 
   !> Position in the in-memory file: the next line starts at buf(pos:); `line` is the number of
   !> the line last returned (0 before the first).
@@ -183,6 +185,11 @@ contains
         call fatal_error(err, path // ": write_gmsh: connectivity refers to a node outside 1..nnode")
         return
       end if
+    end if
+
+    if (.not. all(sound(mesh%x))) then   ! (read_gmsh would refuse the file)
+      call fatal_error(err, path//": "//coordinate_rule)
+      return
     end if
 
     ! written to path.part, renamed when complete (stream: close_complete checks the size)
@@ -807,9 +814,14 @@ contains
     type(cursor_t), intent(inout) :: cur
     real(dp), intent(in) :: x(3)
     type(error_t), allocatable, intent(out) :: err
-    if (.not. all(ieee_is_finite(x) .and. abs(x) <= max_coordinate)) &
-      call fail(err, cur, "node coordinates must be finite numbers of size below 1e15 m")
+    if (.not. all(sound(x))) call fail(err, cur, coordinate_rule)
   end subroutine check_coordinates
+
+  !> a coordinate read_gmsh accepts
+  elemental logical function sound(x)
+    real(dp), intent(in) :: x
+    sound = ieee_is_finite(x) .and. abs(x) <= max_coordinate
+  end function sound
 
   !> Read the whole file as bytes (stream access never trips over line-ending quirks).
   subroutine load_file(path, cur, err)

@@ -157,14 +157,16 @@ contains
   end subroutine model_add_body
 
   !> Normals, element reference data and masses; arrays for restraints and loads.
-  subroutine model_finalize(model, err)
+  subroutine model_finalize(model, err, body)
     type(model_t), intent(inout) :: model
     type(error_t), allocatable, intent(out) :: err
+    integer, intent(out), optional :: body   !< the body err is about (0: none), which the caller names
     type(shell_rule_t) :: mrule
     real(dp) :: phi(10), dphi(10, 2), detmin, h
     integer :: e, l, i
     character(len=200) :: msg
 
+    if (present(body)) body = 0
     model%ndof = ndof_node*model%nnode
     call shell_rule_init(area_points, thick_points, model%rule, err)
     if (allocated(err)) return
@@ -182,9 +184,9 @@ contains
     end do
     do i = 1, model%nnode
       if (norm2(model%v0(:, i)) <= 0) then
-        write (msg, '(a,i0,a,a,a)') 'node ', i - model%body(model%node_body(i))%node_first + 1, &
-          ' of body "', model%body(model%node_body(i))%name, &
-          '" has no normal: the elements around it are degenerate (zero area)'
+        write (msg, '(a,i0,a)') 'node ', i - model%body(model%node_body(i))%node_first + 1, &
+          ' has no normal: the elements around it are degenerate (zero area)'
+        if (present(body)) body = model%node_body(i)
         call fatal_error(err, trim(msg)); return
       end if
       model%v0(:, i) = model%v0(:, i)/norm2(model%v0(:, i))
@@ -199,8 +201,8 @@ contains
       call shell_reference(model%rule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
                            h, model%binv(:, :, :, e), model%wdet(:, e), detmin)
       if (detmin <= 0) then
-        write (msg, '(a,i0,a,a,a)') 'element ', e - model%body(model%elem_body(e))%elem_first + 1, &
-          ' of body "', model%body(model%elem_body(e))%name, '"'
+        write (msg, '(a,i0)') 'element ', e - model%body(model%elem_body(e))%elem_first + 1
+        if (present(body)) body = model%elem_body(e)
         ! (a mid-surface that is sound: the faces cross through the centre of curvature)
         call shell_reference(model%rule, model%x0(:, model%conn(:, e)), model%v0(:, model%conn(:, e)), &
                              1e-6_dp*h, model%binv(:, :, :, e), model%wdet(:, e), detmin)

@@ -25,6 +25,7 @@ module casca_output
   use casca_checked_file, only: checked_file_t, cf_open, cf_write, cf_flush, cf_close, &
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder, locked_here
+  use casca_plots, only: plot_files
   use casca_mesh_indicator, only: indicator_t, mesh_indicator, indicator_lines, indicator_line_len
   implicit none
   private
@@ -124,7 +125,7 @@ contains
     character(len=*), intent(in), optional :: restart_dir   !< the checkpoint's folder
     character(len=col_len), allocatable :: cols(:)
     character(len=:), allocatable :: note, earlier
-    integer :: ios
+    integer :: ios, k
     character(len=256) :: msg
     logical :: own
 
@@ -162,6 +163,13 @@ contains
     end if
     ! (from here the folder is this run's: a refused restart leaves it as it was)
     call delete_file(out%dir//'/'//stopped_name)   ! (an earlier run's)
+    ! an earlier run's plots, unless this run carries on the history they were drawn from (a
+    ! stopped or killed run left them beside its own history, as its own)
+    if (restart_step < 0 .or. .not. own .or. file_kind(earlier) == kind_missing) then
+      do k = 1, size(plot_files)
+        call delete_file(out%dir//'/'//trim(plot_files(k)))
+      end do
+    end if
     call write_file_atomic(out%dir//'/tracked.txt', join(labels, '', new_line('a')), err)
     if (allocated(err)) return
     if (restart_step < 0 .or. file_kind(earlier) == kind_missing) then

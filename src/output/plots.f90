@@ -15,9 +15,14 @@ module casca_plots
   use casca_strings, only: itoa
   implicit none
   private
-  public :: make_plots
+  public :: make_plots, plot_files
 
   character(len=*), parameter :: nl = achar(10)
+  !> Every file make_plots writes into DIR (its script's 'set output' names): a new run into
+  !> the folder removes them, as they are the earlier run's
+  character(len=*), parameter :: plot_files(10) = [character(len=17) :: 'plots.gp', 'gnuplot.log', &
+    'positions_x.png', 'positions_y.png', 'positions_z.png', 'displacements.png', 'energy.png', &
+    'momentum.png', 'contact.png', 'newton.png']
   integer, parameter :: msg_len = 512
   !> UTF-8 middle dot and superscript two for units (kept out of the source as raw bytes).
   character(len=*), parameter :: mdot = char(194)//char(183), sup2 = char(194)//char(178)

@@ -128,9 +128,14 @@ contains
       end associate
     end do
     if (deck%nproblems > 0) return
-    call model_finalize(model, err)
-    if (allocated(err)) then
+    call model_finalize(model, err, ib)
+    if (allocated(err) .and. ib == 0) then
       call add_problem(deck, 0, err%message); return
+    else if (allocated(err)) then   ! (an element of ib's mesh: said as the mesh reader says it)
+      associate (b => deck%bodies(ib))
+        if (b%mesh == 'file') err%message = deck_file(deck, b%file)//': '//err%message
+        call add_problem(deck, b%line, '&body '//trim(b%name)//': '//err%message); return
+      end associate
     end if
 
     do i = 1, size(deck%restraints)
