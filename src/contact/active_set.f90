@@ -136,7 +136,12 @@ contains
         ! onto a floor met stick forces of 900 N against its 1 N weight and tensile
         ! multipliers, and the set did not settle. Not always: a thick hoop's sliding nodes
         ! taken so made 0.065% of its energy in a step, by the friction work's account.)
-        if (cn%grip == stick .and. .not. c%opt%stick_at_touch .and. c%set%cycling) then
+        ! A node released in this solve and taken again has cycled by itself: the same (a
+        ! plate sliding over another's edge: its tail's nodes, released, were taken again
+        ! sticking with the step's whole slip, 1e3 N against its 3.8 N weight, tipping it and
+        ! releasing others; some 100 nodes, the set never repeated and ran out of decisions)
+        if (cn%grip == stick .and. .not. c%opt%stick_at_touch .and. &
+            (c%set%cycling .or. gone(c%set, cn, c%npairs))) then
           if (norm2(cn%ut) > max(c%opt%slip_floor, c%mu_s(cn%pair)*(-cn%gap))) then
             cn%grip = slip; cn%s = cn%ut/norm2(cn%ut); cn%s0 = cn%s
           end if
@@ -243,6 +248,7 @@ contains
     integer :: k
     c%set%changes = 0
     c%set%nseen = 0; c%set%cycling = .false.; c%set%decisions = 0
+    c%set%ngone = 0
     c%follow_slip = .false.; c%hold_slip = .false.
     c%set%act(1:c%set%nact)%flips = 0
     do k = 1, c%set%nact
@@ -297,6 +303,37 @@ contains
     set%seen(:, set%nseen) = key
   end subroutine remember_set
 
+  !> set_key's number of constraint a
+  pure integer(i8) function key_of(a, npairs)
+    type(constraint_t), intent(in) :: a
+    integer, intent(in) :: npairs
+    key_of = int(a%node, i8)*int(npairs + 1, i8) + a%pair
+  end function key_of
+
+  !> Note a constraint released in this solve (active_set_t%gone)
+  subroutine note_gone(set, key)
+    type(active_set_t), intent(inout) :: set
+    integer(i8), intent(in) :: key
+    integer(i8), allocatable :: tmp(:)
+    if (.not. allocated(set%gone)) allocate (set%gone(16))
+    if (set%ngone == size(set%gone)) then
+      allocate (tmp(2*size(set%gone)))
+      tmp(1:set%ngone) = set%gone(1:set%ngone)
+      call move_alloc(tmp, set%gone)
+    end if
+    set%ngone = set%ngone + 1
+    set%gone(set%ngone) = key
+  end subroutine note_gone
+
+  !> Whether constraint a was released in this solve
+  pure logical function gone(set, a, npairs)
+    type(active_set_t), intent(in) :: set
+    type(constraint_t), intent(in) :: a
+    integer, intent(in) :: npairs
+    gone = .false.
+    if (set%ngone > 0) gone = any(set%gone(1:set%ngone) == key_of(a, npairs))
+  end function gone
+
   !> Two sums over the active constraints, of the (node, pair) numbers and of their squares:
   !> the same for the same set, whatever its order
   pure function set_key(set, npairs) result(key)
@@ -306,7 +343,7 @@ contains
     integer :: k
     key = 0
     do k = 1, set%nact
-      m = int(set%act(k)%node, i8)*int(npairs + 1, i8) + set%act(k)%pair
+      m = key_of(set%act(k), npairs)
       key = key + [m, m*m]
     end do
   end function set_key
@@ -333,7 +370,10 @@ contains
     end if
     m = 0
     do k = 1, c%set%nact
-      if (tensile(c%set%act(k)) .and. (only == 0 .or. k == only)) cycle
+      if (tensile(c%set%act(k)) .and. (only == 0 .or. k == only)) then
+        call note_gone(c%set, key_of(c%set%act(k), c%npairs))
+        cycle
+      end if
       m = m + 1
       c%set%act(m) = c%set%act(k)
     end do
