@@ -80,7 +80,7 @@ module casca_newton
     integer :: nincr = 0              !< increments kept
     real(dp) :: incr(max_hist) = 0    !< max |dq| / scene size of each kept increment
     real(dp) :: energy = 0            !< strain energy at the last assembled iterate
-    real(dp) :: residual = 0          !< estimated |R| / scene force at the converged iterate
+    real(dp) :: residual = 0          !< |R| / scene force: last iterate's (next's if converged)
     real(dp) :: force_scale = 0       !< the scene's force it was judged against [N]
     integer :: neg_pivots = 0         !< of the factors in use (inertia)
     integer :: analyses = 0           !< symbolic analyses done in this solve
@@ -129,10 +129,8 @@ contains
     real(dp) :: taken(max_hist)   !< rep%incr before any line-search shortening
     logical :: fresh, refresh_next
 
-    if (asm%neq_total == 0) then   ! every body is frozen this step: nothing to solve
-      rep%converged = .true.
-      return
-    end if
+    rep%converged = asm%neq_total == 0   ! every body is frozen this step: nothing to solve
+    if (rep%converged) return
     allocate (r(model%ndof), res(model%ndof))
     q_entry = q
     if (present(contact)) then
@@ -195,7 +193,7 @@ contains
       end if
       if (gap_open()) cycle
       rep%converged = .true.
-      rep%residual = residual_estimate()/max(fref, tiny(1._dp)); rep%force_scale = fref
+      rep%residual = residual_estimate()/max(fref, tiny(1._dp))
       rep%neg_pivots = negative_pivots(ls, asm, nc)
       return
     end do
@@ -240,6 +238,7 @@ contains
       rnorm = maxval(abs(res))
       fref = max(maxval(abs(fext)), fpress, maxval(abs(r + fext), mask=.not. model%fixed), &
                  maxval(abs(res - r), mask=.not. model%fixed))
+      rep%residual = rnorm/max(fref, tiny(1._dp)); rep%force_scale = fref   ! (also on failure)
     end subroutine full_residual
 
     !> the residual at the new iterate: the last one, shrunk as the increments contract
