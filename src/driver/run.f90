@@ -1194,7 +1194,13 @@ contains
       end if
       ! the mesh indicator of the last state, per body (issue 18)
       lines = output_indicator_lines(r%out, model, r%st)
-      print '(a)', (trim(lines(k)), k=1, size(lines))
+      do k = 1, size(lines)   ! (its warnings to stderr, as the others)
+        if (index(lines(k), 'warning: ') == 1) then
+          write (0, '(a)') trim(lines(k))
+        else
+          print '(a)', trim(lines(k))
+        end if
+      end do
     end associate
   end subroutine finish
   !> The run's energies and momenta now (accounting.f90); the total holds a compliant contact's
