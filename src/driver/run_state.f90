@@ -73,6 +73,9 @@ module casca_run_state
     real(dp) :: dt_made_before = 0              !< the free step before it, when shorter (grown back)
     real(dp) :: e_scale = 0                     !< the largest energy the bodies held or the loads did
     integer :: made_contacts = 0
+    !> the end of the last step with a contact active, and its value when the most was made
+    !> (energy made a few steps after a release is the release's: warn_energy)
+    real(dp) :: t_touch = 0, touch_made = 0
     integer :: made_between = 0                 !< of them, between bodies (not obstacles)
     !> bodies under gravity start held by their contacts (a = 0): the first step makes energy
     !> by that start (Newmark: (gamma^2/2 - beta) m g^2 dt^2), not by the contact; held_g2:
