@@ -248,7 +248,7 @@ contains
     integer :: k
     c%set%changes = 0
     c%set%nseen = 0; c%set%cycling = .false.; c%set%decisions = 0
-    c%set%ngone = 0
+    c%set%gone = [integer(i8) ::]
     c%follow_slip = .false.; c%hold_slip = .false.
     c%set%act(1:c%set%nact)%flips = 0
     do k = 1, c%set%nact
@@ -310,28 +310,13 @@ contains
     key_of = int(a%node, i8)*int(npairs + 1, i8) + a%pair
   end function key_of
 
-  !> Note a constraint released in this solve (active_set_t%gone)
-  subroutine note_gone(set, key)
-    type(active_set_t), intent(inout) :: set
-    integer(i8), intent(in) :: key
-    integer(i8), allocatable :: tmp(:)
-    if (.not. allocated(set%gone)) allocate (set%gone(16))
-    if (set%ngone == size(set%gone)) then
-      allocate (tmp(2*size(set%gone)))
-      tmp(1:set%ngone) = set%gone(1:set%ngone)
-      call move_alloc(tmp, set%gone)
-    end if
-    set%ngone = set%ngone + 1
-    set%gone(set%ngone) = key
-  end subroutine note_gone
-
   !> Whether constraint a was released in this solve
   pure logical function gone(set, a, npairs)
     type(active_set_t), intent(in) :: set
     type(constraint_t), intent(in) :: a
     integer, intent(in) :: npairs
     gone = .false.
-    if (set%ngone > 0) gone = any(set%gone(1:set%ngone) == key_of(a, npairs))
+    if (allocated(set%gone)) gone = any(set%gone == key_of(a, npairs))
   end function gone
 
   !> Two sums over the active constraints, of the (node, pair) numbers and of their squares:
@@ -371,7 +356,7 @@ contains
     m = 0
     do k = 1, c%set%nact
       if (tensile(c%set%act(k)) .and. (only == 0 .or. k == only)) then
-        call note_gone(c%set, key_of(c%set%act(k), c%npairs))
+        c%set%gone = [c%set%gone, key_of(c%set%act(k), c%npairs)]   ! (contact_solve_start made it)
         cycle
       end if
       m = m + 1

@@ -149,7 +149,6 @@ module casca_contact
     !> the constraints (node, pair: set_key's number) released in this solve: one taken again
     !> has cycled by itself, and comes in sliding as in a cycling set
     integer(i8), allocatable :: gone(:)
-    integer :: ngone = 0
   end type active_set_t
 
   !> A contact problem: its options, pairs and obstacles, the targets' geometry, the active

@@ -21,7 +21,7 @@ module casca_run
   use casca_accounting, only: balance_t, account, gravity_load, balance_summary, &
                               energy_balance, balance_remainder
   use casca_output, only: output_open, output_history, output_frame, output_close, output_mark_stopped, &
-                          output_flush, output_release, output_indicator_lines
+                          output_flush, output_release, output_indicator_report
   use casca_vtu_writer, only: field_t, field
   use casca_mesh_indicator, only: indicator_line_len
   use casca_contact, only: contact_t
@@ -1158,7 +1158,7 @@ contains
   subroutine finish(r)
     type(run_t), intent(inout) :: r
     type(error_t), allocatable :: e
-    character(len=indicator_line_len), allocatable :: lines(:)
+    character(len=indicator_line_len), allocatable :: lines(:), warnings(:)
     character(len=:), allocatable :: from
     logical :: missing
     integer :: k
@@ -1193,13 +1193,10 @@ contains
         print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact, corrections=.true.))
       end if
       ! the mesh indicator of the last state, per body (issue 18)
-      lines = output_indicator_lines(r%out, model, r%st)
-      do k = 1, size(lines)   ! (its warnings to stderr, as the others)
-        if (index(lines(k), 'warning: ') == 1) then
-          write (0, '(a)') trim(lines(k))
-        else
-          print '(a)', trim(lines(k))
-        end if
+      call output_indicator_report(r%out, model, r%st, lines, warnings)
+      print '(a)', (trim(lines(k)), k=1, size(lines))
+      do k = 1, size(warnings)   ! (stderr, as the others)
+        write (0, '(a)') trim(warnings(k))
       end do
     end associate
   end subroutine finish

@@ -26,7 +26,8 @@ module casca_mesh_indicator
   use casca_orientation, only: vertex_elements
   implicit none
   private
-  public :: indicator_t, mesh_indicator, indicator_lines, element_neighbours, indicator_line_len
+  public :: indicator_t, mesh_indicator, indicator_lines, indicator_warnings, element_neighbours, &
+            indicator_line_len
 
   !> The indicator of every element and each body's summary
   type :: indicator_t
@@ -232,35 +233,44 @@ contains
   end subroutine mesh_indicator
 
   !> One line per body for the end report: its largest rel_e, that element (numbered within
-  !> the body, as in its mesh) and where the mean of its vertices starts, and the body figure;
-  !> after it a warning where rel_e reaches unresolved (a thin sphere glancing off a rigid one
-  !> ended at 6.27 with the figure on stdout alone)
+  !> the body, as in its mesh) and where the mean of its vertices starts, and the body figure
   function indicator_lines(model, ind) result(lines)
+    type(model_t), intent(in) :: model
+    type(indicator_t), intent(in) :: ind
+    character(len=indicator_line_len) :: lines(model%nbody)
+    real(dp) :: c(3)
+    integer :: b, e
+    do b = 1, model%nbody
+      e = ind%body_worst(b)
+      if (e == 0) then
+        write (lines(b), '(a,a,a)') 'mesh indicator: ', model%body(b)%name, &
+          ' max 0 (no shared edges, or no strain above 1e-10), rms 0'
+        cycle
+      end if
+      c = sum(model%x0(:, model%conn(1:3, e)), dim=2)/3
+      write (lines(b), '(a,a,a,es9.2,a,i0,a,3(1x,es10.3),a,es9.2)') 'mesh indicator: ', &
+        model%body(b)%name, ' max', ind%body_max(b), ' (element ', e - model%body(b)%elem_first + 1, &
+        ' at', c, '), rms', ind%body_rms(b)
+    end do
+  end function indicator_lines
+
+  !> A warning for each body whose largest rel_e reaches unresolved (a thin sphere glancing off
+  !> a rigid one ended at 6.27 with the figure on the report's line alone)
+  function indicator_warnings(model, ind) result(lines)
     type(model_t), intent(in) :: model
     type(indicator_t), intent(in) :: ind
     character(len=indicator_line_len), allocatable :: lines(:)
     character(len=indicator_line_len) :: line
-    real(dp) :: c(3)
-    integer :: b, e
+    integer :: b
     allocate (lines(0))
     do b = 1, model%nbody
-      e = ind%body_worst(b)
-      if (e == 0) then
-        lines = [lines, 'mesh indicator: '//model%body(b)%name// &
-                        ' max 0 (no shared edges, or no strain above 1e-10), rms 0']
-        cycle
-      end if
-      c = sum(model%x0(:, model%conn(1:3, e)), dim=2)/3
-      write (line, '(a,a,a,es9.2,a,i0,a,3(1x,es10.3),a,es9.2)') 'mesh indicator: ', &
-        model%body(b)%name, ' max', ind%body_max(b), ' (element ', e - model%body(b)%elem_first + 1, &
-        ' at', c, '), rms', ind%body_rms(b)
-      lines = [lines, line]
-      if (ind%body_max(b) < unresolved) cycle
+      if (ind%body_worst(b) == 0 .or. ind%body_max(b) < unresolved) cycle
       write (line, '(a,a,a,i0,a,f0.2,a)') 'warning: body ''', trim(model%body(b)%name), &
-        ''': at its element ', e - model%body(b)%elem_first + 1, ' the stress resultants are off by ', &
-        ind%body_max(b), ' times the body''s typical resultant (mesh indicator): the mesh does '// &
-        'not resolve the stresses there; refine it there (docs/mesh_indicator.md)'
+        ''': at its element ', ind%body_worst(b) - model%body(b)%elem_first + 1, &
+        ' the stress resultants are off by ', ind%body_max(b), ' times the body''s typical '// &
+        'resultant (mesh indicator): the mesh does not resolve the stresses there; refine it '// &
+        'there (docs/mesh_indicator.md)'
       lines = [lines, line]
     end do
-  end function indicator_lines
+  end function indicator_warnings
 end module casca_mesh_indicator

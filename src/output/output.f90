@@ -4,7 +4,7 @@
 !>                                energies per body, force and contacts per contact pair
 !>   tracked.txt                  a label per tracked node (for the plots)
 !> Each frame carries the mesh indicator per cell (casca_mesh_indicator); the last one computed
-!> is kept for the run's end report (output_indicator_lines).
+!> is kept for the run's end report (output_indicator_report).
 module casca_output
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
@@ -26,11 +26,12 @@ module casca_output
                                 cf_discard, write_file_atomic
   use casca_output_lock, only: lock_folder, unlock_folder, locked_here
   use casca_plots, only: plot_files
-  use casca_mesh_indicator, only: indicator_t, mesh_indicator, indicator_lines, indicator_line_len
+  use casca_mesh_indicator, only: indicator_t, mesh_indicator, indicator_lines, indicator_warnings, &
+                                  indicator_line_len
   implicit none
   private
   public :: output_t, output_open, output_history, output_frame, output_close, output_flush, &
-            output_release, output_indicator_lines, output_mark_stopped
+            output_release, output_indicator_report, output_mark_stopped
 
   !> written into the output folder by a run that stopped before t_end (why, when, and the
   !> state to restart from), removed when a run opens the folder: the history and frames of
@@ -433,20 +434,22 @@ contains
     call write_pvd(out%dir//'/run.pvd', out%files, out%times, err)
   end subroutine output_frame
 
-  !> The end report's lines of the mesh indicator (one per body) for the state st: the last
-  !> frame's when it was written at st's step, else computed now (vtu = .false., a restart
-  !> without frames), so a run computes it at its frames and at most once more. Rank 0.
-  function output_indicator_lines(out, model, st) result(lines)
+  !> The end report's lines of the mesh indicator (one per body) and its warnings for the
+  !> state st: the last frame's when it was written at st's step, else computed now (vtu =
+  !> .false., a restart without frames), so a run computes it at its frames and at most once
+  !> more. Rank 0.
+  subroutine output_indicator_report(out, model, st, lines, warnings)
     type(output_t), intent(inout) :: out
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
-    character(len=indicator_line_len), allocatable :: lines(:)
+    character(len=indicator_line_len), allocatable, intent(out) :: lines(:), warnings(:)
     if (out%ind_step /= st%step .or. .not. allocated(out%ind%rel)) then
       call mesh_indicator(model, st%q, out%ind)
       out%ind_step = st%step
     end if
     lines = indicator_lines(model, out%ind)
-  end function output_indicator_lines
+    warnings = indicator_warnings(model, out%ind)
+  end subroutine output_indicator_report
 
   !> The stress fields of a frame. Per cell, at the centroid: von_mises (mid-surface),
   !> von_mises_top, von_mises_bottom and the Cauchy stress tensors stress_top, stress_mid,
