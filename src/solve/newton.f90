@@ -46,7 +46,7 @@ module casca_newton
                           t_solve
   implicit none
   private
-  public :: newton_opts_t, newton_report_t, newton_solve
+  public :: newton_opts_t, newton_report_t, newton_solve, contraction
 
   integer, parameter :: max_hist = 100
   integer, parameter :: max_set_changes = 12   !< active-set decisions per step before a cut

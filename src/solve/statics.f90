@@ -25,7 +25,7 @@ module casca_statics
   use casca_shell_element, only: ndof_node
   use casca_assembly, only: assembly_t
   use casca_linear_system, only: linear_system_t
-  use casca_newton, only: newton_opts_t, newton_report_t, newton_solve
+  use casca_newton, only: newton_opts_t, newton_report_t, newton_solve, contraction
   use casca_contact, only: contact_t, constraint_t, set_restore
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
@@ -97,11 +97,11 @@ contains
                       err%message
         return
       end if
-      ! (a Newton that ran out of iterations far from equilibrium, or converging, tries the
-      ! half and the quarter first; one whose residual is within tolerance and whose increments keep their
-      ! size has a free motion, which no half cures: a sphere under its own pressure)
-      if (allocated(err) .and. tries == 0 .and. level < probe_levels .and. (level == 0 .or. probed) .and. &
-          rep%iters >= opts%max_iter .and. (rep%residual > opts%force_tol .or. converging(rep))) then
+      ! (Newton out of iterations far from equilibrium, or converging: the half and quarter
+      ! first, the levels before a stabilised solve being these; within its force tolerance,
+      ! its increments not shrinking, a free motion no half cures: a sphere under pressure)
+      if (allocated(err) .and. tries == 0 .and. level < probe_levels .and. rep%iters >= opts%max_iter &
+          .and. (rep%residual > opts%force_tol .or. converging(rep))) then
         probed = .true.; level = level + 1; iters = iters + rep%iters
         deallocate (err)
         cycle
@@ -135,11 +135,11 @@ contains
     rep%iters = iters
   end subroutine static_solve
 
-  !> The last two increments shrink tenfold or more (Newton near its end)
+  !> The last increment a tenth of the one before or less (Newton near its end)
   logical pure function converging(rep)
     type(newton_report_t), intent(in) :: rep
     converging = .false.
-    if (rep%nincr >= 2) converging = rep%incr(rep%nincr) < 0.1_dp*rep%incr(rep%nincr - 1)
+    if (rep%nincr >= 2) converging = contraction(rep) < 0.1_dp
   end function converging
 
   !> One load step through stabilised stages (module comment); unheld: a body kept moving.
