@@ -225,6 +225,9 @@ cases = [  # (name, text transformation, substrings the message must hold)
                                               "  young = 210e9, poisson = 0.3, density = 7700, thickness = 0.05\n"
                                               "  thickness = 0.025\n", 1),
      ["&body", "thickness is given twice (lines 12 and 13)", "keep one", ":13:"]),
+    # (a key given twice stopped the check there, and the deck's other problems went untold)
+    ("a key given twice and a bad value", lambda s: s.replace("young = 210e9", "young = -1.0, young = -1.0", 1),
+     ["young is given twice on this line", ":12:", "young must be > 0", "2 problems in the deck"]),
     ("an empty value", lambda s: s.replace("young = 210e9, poisson", "young = 210e9,, poisson", 1),
      ["&body", "young has an empty value", ":12:"]),
     ("a vector short of a number", lambda s: s.replace("velocity = 10.0, 0.0, 0.0", "velocity = 10.0, 0.0", 1),

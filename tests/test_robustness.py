@@ -1,7 +1,7 @@
 """Scenes written by others (issue 14: robustness of Newton, statics, contact, energy).
 
 usage: test_robustness.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR [CASE ...]
-  CASE (default all): shipped slit oblique plate_strike trapezoidal rim resting bounce
+  CASE (default all): shipped slit oblique plate_strike trapezoidal rim resting bounce buckling
 
 shipped      every deck in examples/ runs to its end with exit 0 (ball_bounce: its total
              energy, with what the compliant contact holds, within 1e-3 of E0 at every step,
@@ -88,6 +88,14 @@ bounce       an aluminium ball (R 50 mm, h 2 mm, n_div 3) dropped from 2 mm onto
 Every bound comes from a published table, an analytic answer or a conservation law; none is
 copied from casca's output. Each case prints its wall time (budget for the file: about 4 minutes
 on 2 cores).
+buckling     a static path past a buckling point is told: a clamped column (strip 1 x 0.1 m,
+             h 10 mm, E 1 GPa, nu 0, 16 x 1 cells) under an end compression of 1.5 times
+             Euler's load pi^2 E I / (4 L^2) in 10 load steps stays straight (no imperfection),
+             and its tangent stiffness turns indefinite at 1 / 1.5 of the load: the run warns
+             that it first had negative pivots at load factor 0.7 and none at 0.6 (the steps
+             around Euler's 0.667), and history.dat's neg_pivots is 0 up to 0.6 and 1 from
+             0.7 (kept factors of the unloaded state hid it before). At 0.9 times Euler's load
+             there is no warning and no negative pivot.
 """
 import glob
 import os
@@ -106,7 +114,7 @@ import make_slit_annular_plate as slit_mesh  # noqa: E402
 
 casca, examples, meshdir, work = [os.path.abspath(a) for a in sys.argv[1:5]]
 CASES = sys.argv[5:] or ["shipped", "slit", "oblique", "plate_strike", "trapezoidal", "rim", "glance", "resting",
-                         "bounce"]
+                         "bounce", "buckling"]
 os.makedirs(work, exist_ok=True)
 ck = Checks()
 STEEL_E, STEEL_NU, STEEL_RHO = 210e9, 0.3, 7700.0
@@ -607,6 +615,40 @@ if "resting" in CASES:
         ck.record("resting, %s: no energy warning (stderr)" % label, "warning: the step" not in LAST_STDERR[0],
                   LAST_STDERR[0][-300:])
     timings["resting"] = time.time() - t0
+
+if "buckling" in CASES:
+    t0 = time.time()
+    E, L, b, hh = 1e9, 1.0, 0.1, 0.01
+    euler = np.pi ** 2 * E * b * hh ** 3 / 12 / (4 * L ** 2)
+    for label, share in (("over", 1.5), ("under", 0.9)):
+        deck = os.path.join(work, "buckling_%s.nml" % label)
+        with open(deck, "w") as f:
+            f.write("""&run analysis = 'static', load_steps = 10 /
+&output vtu = .false., plots = .false. /
+&body name = 'column', mesh = 'strip', lx = %r, ly = %r, nx = 16, ny = 1,
+  young = %r, poisson = 0.0, density = 1000.0, thickness = %r /
+&restraint body = 'column', box_max = 0.0, 1e9, 1e9, fix = 'clamped' /
+&load body = 'column', box_min = %r, -1e9, -1e9, kind = 'edge', force = %r, 0.0, 0.0 /
+""" % (L, b, E, hh, L, -share * euler))
+        h, ok = run_deck("buckling_" + label, deck)
+        warned = re.search(r"negative pivots from load factor (\S+) on \(at most (\d+); none at (\S+)\)",
+                           LAST_STDERR[0])
+        if label == "over":
+            ck.record("buckling, 1.5 x Euler: warned that the stiffness first had negative pivots at "
+                      "load factor 0.7, none at 0.6 (Euler's load at 1/1.5 = 0.667 between)",
+                      warned is not None and abs(float(warned.group(1)) - 0.7) < 1e-9
+                      and abs(float(warned.group(3)) - 0.6) < 1e-9, LAST_STDERR[0][-400:])
+            if h is not None:
+                neg = h["neg_pivots"][h["t"] > 0]
+                ck.record("buckling, 1.5 x Euler: neg_pivots 0 at factors 0.1 to 0.6, 1 at 0.7 to 1",
+                          list(neg) == [0] * 6 + [1] * 4, str(list(neg)))
+        else:
+            ck.record("buckling, 0.9 x Euler: no warning of negative pivots", warned is None,
+                      LAST_STDERR[0][-400:])
+            if h is not None:
+                ck.record("buckling, 0.9 x Euler: no negative pivot at any load step",
+                          not h["neg_pivots"].any(), str(list(h["neg_pivots"])))
+    timings["buckling"] = time.time() - t0
 
 if "bounce" in CASES:
     t0 = time.time()

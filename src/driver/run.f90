@@ -42,8 +42,8 @@ module casca_run
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
   use casca_run_state, only: run_t, progress_t, exit_ok, exit_input, exit_solver, exit_signal, cap_hold, &
                              newton_share, newton_floor
-  use casca_run_watch, only: watch_energy, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, &
-                             rest_now, made_judged, warn_dynamic, balance_terms, moving_obstacles
+  use casca_run_watch, only: watch_energy, watch_stability, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, &
+                             rest_now, made_judged, warn_at_end, balance_terms, moving_obstacles
   implicit none
   private
   public :: load_scene, run_deck, exit_ok, exit_input
@@ -521,6 +521,7 @@ contains
         end if
         st%t = real(i, dp)/nsteps; st%step = i
         call account_state(r, factor=st%t)   ! (issue 17)
+        call watch_stability(r, stabilised > 0)
         call watch_thickness(r)
         call watch_faces(r)
         if (.not. row_and_frame(r, r%rep%iters)) return
@@ -1072,7 +1073,7 @@ contains
     reason = why   ! (why may be r%err's message, which the frame and checkpoint below reset)
     if (is_root()) write (0, '(a)') 'error: the solver cannot go on '//when(r)//': '//reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
-    call warn_dynamic(r)
+    call warn_at_end(r)
     call watch_faces(r)   ! (the last good state)
     call keep_and_stop(r, reason)
     ! (a thin hoop bouncing off a dome under the trapezoidal rule: Newton stalled in free
@@ -1091,8 +1092,13 @@ contains
       write (0, '(a)') 'hint: the Schur complement C K^-1 C^T fails where the stiffness K is '// &
         'near-singular in directions the contacts hold (a buckled shell); solver = ''saddle'' '// &
         '(&contact) factorises the whole saddle-point matrix, which is regular there'
+    else if (is_root() .and. index(reason, 'did not come to rest') > 0) then
+      write (0, '(a)') 'hint: near load factor '//rtoa(r%st%t)//' the structure buckles or snaps: '// &
+        'past that point load control has no stable equilibrium near, and smaller load steps '// &
+        'come no nearer one; analysis = ''dynamic'' follows where the structure goes (longer '// &
+        'load steps may step past it onto the unstable path beyond, with a warning)'
     else if (is_root() .and. index(reason, 'static Newton did not converge') > 0 .and. &
-             index(reason, 'no equilibrium') == 0) then
+             index(reason, 'no equilibrium: body') == 0) then
       write (0, '(a)') 'hint: more load_steps (&run, now '//itoa(r%deck%run%load_steps)//') start '// &
         'from smaller increments, and a larger max_step_cuts (now '//itoa(r%deck%run%max_step_cuts)// &
         ') lets a load step be halved more often'
@@ -1146,7 +1152,7 @@ contains
     if (r%code == exit_solver) return   ! (checkpoint said why, and where a restart can start)
     where_kept = 'the last good state is in '//r%kept
     ! (a body that nothing holds has no equilibrium to go on to, from any state)
-    if (index(reason, 'no equilibrium') == 0) where_kept = where_kept//' ('//restart_hint(r)//')'
+    if (index(reason, 'no equilibrium: body') == 0) where_kept = where_kept//' ('//restart_hint(r)//')'
     if (r%deck%output%vtu) where_kept = where_kept//' and in the last frame of '//r%dir//'/run.pvd'
     call output_mark_stopped(r%out, 'this run stopped '//when(r)//': '//reason//new_line('a')//where_kept)
     call output_close(r%out, e)
@@ -1176,7 +1182,7 @@ contains
       if (missing) write (0, '(a)') 'warning: gnuplot is not installed: '//r%dir// &
         '/plots.gp was written but not run'
     end if
-    call warn_dynamic(r)
+    call warn_at_end(r)
     if (is_root() .and. squeezed(r)) write (0, '(a)') 'warning: '//squeeze_note(r)
     if (.not. is_root() .or. r%quiet) return
     associate (deck => r%deck, model => r%model)
@@ -1190,7 +1196,8 @@ contains
         print '(a)', balance_summary(r%bal0, r%bal, model%length, any(model%fixed) .or. &
                                      any(r%fext /= 0) .or. size(deck%obstacles) > 0 .or. &
                                      any(model%pressure /= 0) .or. any(model%moment /= 0))
-        print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact, corrections=.true.))
+        print '(a)', energy_balance(r%bal0, r%bal, balance_terms(deck, r%contact, corrections=.true.), &
+                                    held=r%e_scale)
       end if
       ! the mesh indicator of the last state, per body (issue 18)
       call output_indicator_report(r%out, model, r%st, lines, warnings)

@@ -36,6 +36,14 @@ module casca_run_state
     real(dp) :: t_past = -1   !< when it first went below svk_limit (-1: never)
   end type least_t
 
+  !> statics: the tangent stiffness's negative pivots on what the contacts leave free, over
+  !> the load steps (watch_stability): the most, the last load factor with none before they
+  !> appeared, the first and the last with any (-1: none yet)
+  type :: stability_t
+    integer :: most = 0
+    real(dp) :: t_before = -1, t_first = -1, t_last = -1
+  end type stability_t
+
   type :: progress_t   !< where the last progress line was
     real(dp) :: wall = 0, t = 0
     integer :: step = 0, newton = 0
@@ -85,6 +93,7 @@ module casca_run_state
     !> the least stretches the run's states reached, through the thickness and along the
     !> faces, where and when (watch_thickness, watch_faces)
     type(least_t) :: thick, face
+    type(stability_t) :: stability
     !> the deepest a contact node sank into its target (the history's penetration column):
     !> how deep, which node, when (warn_sink)
     real(dp) :: sink = 0, t_sink = 0

@@ -8,14 +8,14 @@ module casca_run_watch
   use casca_model, only: thinnest, least_face_stretch
   use casca_accounting, only: energy_term_t, balance_remainder, energy_put
   use casca_contact, only: contact_t
-  use casca_contact_rows, only: pair_stored_energy
+  use casca_contact_rows, only: pair_stored_energy, contact_newton_nrows
   use casca_mpi, only: is_root
   use casca_strings, only: count_of, rtoa, vtoa, ftoa, itoa
   use casca_run_state, only: run_t, least_t, svk_limit
   implicit none
   private
-  public :: watch_energy, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, rest_now, &
-            made_judged, warn_dynamic, balance_terms, moving_obstacles
+  public :: watch_energy, watch_stability, watch_thickness, watch_faces, watch_sink, squeezed, squeeze_note, rest_now, &
+            made_judged, warn_at_end, balance_terms, moving_obstacles
 
   !> energy a step made within this many steps after a contact's release is put down to it
   integer, parameter :: released_steps = 4
@@ -54,6 +54,45 @@ contains
       r%made_between = max(r%made_between, count(c%pair(2, c%set%act(1:c%set%nact)%pair) > 0))
     end subroutine count_active
   end subroutine watch_energy
+
+  !> Statics: keep where the load step just taken (rep, at load factor r%st%t) had negative
+  !> pivots in its tangent stiffness. The saddle-point matrix has one negative pivot per
+  !> contact row besides the stiffness's own on what the rows leave free (its inertia, as
+  !> the Schur path counts it too). Counted from a load step that had none on: a body that
+  !> its contacts alone hold, or nothing (a free sphere under pressure), has zero pivots of
+  !> round-off's sign from its first step, and a stabilised step's tangent is such a one.
+  subroutine watch_stability(r, stabilised)
+    type(run_t), intent(inout) :: r
+    logical, intent(in) :: stabilised   !< the step took the stabilised path
+    integer :: neg
+    if (stabilised) return
+    neg = r%rep%neg_pivots
+    if (allocated(r%contact)) neg = neg - contact_newton_nrows(r%contact)
+    if (neg <= 0 .and. r%stability%t_first < 0) r%stability%t_before = r%st%t
+    if (neg <= 0 .or. r%stability%t_before < 0) return
+    if (r%stability%t_first < 0) r%stability%t_first = r%st%t
+    r%stability%t_last = r%st%t
+    r%stability%most = max(r%stability%most, neg)
+  end subroutine watch_stability
+
+  !> A static path that went through load steps whose tangent stiffness is not positive
+  !> definite says so: past a bifurcation or a limit load the equilibria load control
+  !> follows are unstable (Sze's strip rolled by an end moment, from about 280 degrees on:
+  !> it twists out of its plane; a run of small load steps cannot get past that point,
+  !> docs/performance.md)
+  subroutine warn_unstable(r)
+    type(run_t), intent(in) :: r
+    character(len=:), allocatable :: upto
+    if (r%stability%t_first < 0) return
+    upto = ' on'
+    if (r%stability%t_last < r%st%t) upto = ' to '//rtoa(r%stability%t_last)
+    write (0, '(a)') 'warning: the tangent stiffness had negative pivots from load factor '// &
+      rtoa(r%stability%t_first)//upto//' (at most '//itoa(r%stability%most)//'; none at '// &
+      rtoa(r%stability%t_before)//'): the load passed a buckling point, a bifurcation or a limit '// &
+      'load, between '//rtoa(r%stability%t_before)//' and '//rtoa(r%stability%t_first)//', and '// &
+      'the equilibria load control found past it are unstable ones, which the structure would '// &
+      'leave (analysis = ''dynamic'' follows where it goes)'
+  end subroutine warn_unstable
 
   !> Keep the least thickness stretch of the run's states (thinnest; every step)
   subroutine watch_thickness(r)
@@ -156,15 +195,19 @@ contains
     if (r%held_at_start .and. r%st%step == 1) made_judged = made - r%held_g2*r%nm%dt**2
   end function made_judged
 
-  !> What a dynamic run warns of at its end or stop (rank 0): energy made, Coulomb's bound
-  subroutine warn_dynamic(r)
+  !> What a run warns of at its end or stop (rank 0): a node sunk into its target; in
+  !> statics an unstable path; in dynamics energy made and Coulomb's bound
+  subroutine warn_at_end(r)
     type(run_t), intent(in) :: r
-    if (.not. is_root() .or. r%deck%run%analysis == 'static') return
+    if (.not. is_root()) return
+    call warn_sink(r)
+    if (r%deck%run%analysis == 'static') then
+      call warn_unstable(r); return
+    end if
     call warn_energy(r)
     call warn_made_total(r)
     call warn_coulomb(r)
-    call warn_sink(r)
-  end subroutine warn_dynamic
+  end subroutine warn_at_end
 
   !> The energy the run made over all its steps, not one step's doing: where the printed
   !> balance's remainder ends below -1% of the energy put in and below twice the most one
@@ -178,10 +221,7 @@ contains
     if (r%restart_step >= 0) return
     terms = balance_terms(r%deck, r%contact, corrections=.true.)
     rest = balance_remainder(r%bal0, r%bal, terms)
-    call energy_put(r%bal0, r%bal, terms, put, what)
-    if (r%e_scale > 2*put) then   ! (a run started at rest whose loads did little work yet)
-      put = r%e_scale; what = 'the most energy the bodies held'
-    end if
+    call energy_put(r%bal0, r%bal, terms, put, what, held=r%e_scale)
     if (.not. (-rest > 1e-2_dp*put .and. -rest > 2*r%made_max)) return   ! (not one step's doing)
     write (0, '(a)') 'warning: over the run the time integrator and contact made '// &
       ftoa(-100*rest/put)//'% of '//what//' (the energy balance''s remainder, below 0), no step '// &
@@ -195,14 +235,17 @@ contains
   !> 50 m/s with passes = 2: 30% of h, in silence)
   subroutine warn_sink(r)
     type(run_t), intent(in) :: r
+    character(len=:), allocatable :: at
     integer :: b
     if (.not. allocated(r%contact) .or. r%sink_node == 0) return
+    at = 'at t = '//rtoa(r%t_sink)//' s'
+    if (r%deck%run%analysis == 'static') at = 'at load factor '//rtoa(r%t_sink)
     if (r%contact%opt%compliant) return   ! (a spring's depth is its force over its stiffness)
     b = r%model%node_body(r%sink_node)
     if (r%sink <= 0.1_dp*r%model%body(b)%thickness) return
     write (0, '(a)') 'warning: a contact node of body '''//trim(r%model%body(b)%name)//''' sank '// &
       rtoa(r%sink)//' m ('//itoa(nint(100*r%sink/r%model%body(b)%thickness))//'% of its thickness) '// &
-      'into its target at t = '//rtoa(r%t_sink)//' s (its node '// &
+      'into its target '//at//' (its node '// &
       itoa(r%sink_node - r%model%body(b)%node_first + 1)//'; the penetration column of history.dat): '// &
       'a node pressed on an element that holds a node pressed back is left free of the constraint '// &
       'that would repeat the other''s, may sink, and is held where it is found (passes = 2, '// &

@@ -463,7 +463,7 @@ contains
     character(len=max_line_len) :: line
     character(len=max_line_len), allocatable :: text(:)
     character(len=16) :: name
-    integer :: ios, n, j, k, nread, unknown
+    integer :: ios, n, j, k, nread, readable
     integer, allocatable :: lines(:), key_lines(:)
     character(len=512), allocatable :: msgs(:)
     character(len=20), allocatable :: keys(:)
@@ -511,11 +511,11 @@ contains
     deck%readable_problems = deck%readable_problems + size(lines)
     allocate (deck%key_name(0), deck%key_group_line(0), deck%key_line(0))
     do k = 1, size(gname)
-      call lint_group(text, gline(k), trim(gname(k)), lines, msgs, keys, key_lines, unknown)
+      call lint_group(text, gline(k), trim(gname(k)), lines, msgs, keys, key_lines, readable)
       do j = 1, size(lines)
         call add_problem(deck, lines(j), trim(msgs(j)))
       end do
-      deck%readable_problems = deck%readable_problems + unknown   ! (blanked out of text)
+      deck%readable_problems = deck%readable_problems + readable
       deck%key_name = [character(len=20) :: deck%key_name, keys]
       deck%key_group_line = [deck%key_group_line, spread(gline(k), 1, size(keys))]
       deck%key_line = [deck%key_line, key_lines]

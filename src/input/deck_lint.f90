@@ -84,9 +84,10 @@ contains
   !> a line number and a message (returned, not reported through a callback: an internal
   !> procedure passed as an argument would need a trampoline on an executable stack); and
   !> each key given (not indexed), with its line. An unknown key is blanked out of text with
-  !> its values (unknown: how many), so that the namelist read of the rest still checks the
-  !> other keys' values: one slip does not hide the deck's other problems.
-  subroutine lint_group(text, first, group, lines, msgs, keys, key_lines, unknown)
+  !> its values, so that the namelist read of the rest still checks the other keys' values,
+  !> and a key given twice is read as Fortran reads it (the last): one slip does not hide the
+  !> deck's other problems (readable: how many of these).
+  subroutine lint_group(text, first, group, lines, msgs, keys, key_lines, readable)
     character(len=*), intent(inout) :: text(:)
     character(len=*), intent(in) :: group
     integer, intent(in) :: first
@@ -94,7 +95,7 @@ contains
     character(len=512), allocatable, intent(out) :: msgs(:)
     character(len=20), allocatable, intent(out) :: keys(:)
     integer, allocatable, intent(out) :: key_lines(:)
-    integer, intent(out) :: unknown
+    integer, intent(out) :: readable
     character(len=:), allocatable :: s, key, item
     integer, allocatable :: lineof(:), colof(:)
     integer :: i, j, k, n, p, bad
@@ -105,7 +106,7 @@ contains
 
     ! the group as one string (comments cut), with the line of each character
     allocate (lines(0), msgs(0), keys(0), key_lines(0))
-    unknown = 0; bad = 0   ! (bad: where the unknown key being read starts in s)
+    readable = 0; bad = 0   ! (bad: where the unknown key being read starts in s)
     s = ''
     allocate (lineof(0), colof(0))
     do i = first, size(text)
@@ -196,7 +197,7 @@ contains
           t = key_type(group, key)
           if (t == ' ') then
             call report(lineof(p), '&'//group//': unknown key '''//key//''''//suggestion(group, key))
-            bad = p; unknown = unknown + 1
+            bad = p; readable = readable + 1
           end if
           key_line = lineof(p); nval = 0
           if (t /= ' ' .and. .not. indexed) call once()
@@ -265,6 +266,7 @@ contains
           call report(key_line, '&'//group//': '//key//' is given twice (lines '//itoa(key_lines(m))// &
                       ' and '//itoa(key_line)//'): keep one')
         end if
+        readable = readable + 1
         return
       end do
       keys = [character(len=20) :: keys, key]

@@ -73,7 +73,9 @@ contains
     logical :: probed   !< halves were tried first (doc above)
     integer :: tries   !< stabilised solves tried (module comment)
     type(constraint_t), allocatable :: before(:)
+    character(len=:), allocatable :: damped   !< how the stabilised path failed ('': it did not)
     at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tries = 0; probed = .false.
+    damped = ''
     if (present(contact)) contact%opt%stick_at_touch = .true.
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
@@ -87,11 +89,6 @@ contains
       call newton_solve(model, asm, ls, q, fext*(at + step), opts, rep, err, contact=contact, &
                         load_factor=at + step)   ! the pressures scaled too (issue 17)
       if (.not. allocated(err) .and. .not. rep%converged) call fatal_error(err, 'not converged')
-      ! (first taken to be a body that nothing holds yet; on the load step and on its first
-      ! half, the further halvings are Newton's: a sphere past its buckling pressure spent
-      ! 55 s more with it at every halving, and a hemisphere under its whole load in one
-      ! step, whose whole step was too far for it, stopped at 1/16 of the load where its half
-      ! step took it, as two load steps did)
       if (allocated(err) .and. opts%linear) then   ! (one solve; a singular K0 stays singular)
         err%message = 'the linear solve failed (K0 singular: a body free to move, or a mechanism?): '// &
                       err%message
@@ -109,24 +106,30 @@ contains
       if (allocated(err) .and. probed .and. tries == 0) then   ! (what is left, as below)
         level = 0; step = to - at
       end if
+      ! (stabilised on the step and its first half only: a sphere past its buckling pressure
+      ! spent 55 s more at every halving; a hemisphere whose whole load was too far stopped
+      ! at 1/16 of it without the half's, which took it through as two load steps do)
       if (allocated(err) .and. (tries == 0 .or. (tries == 1 .and. level == 1))) then
         iters = iters + rep%iters; tries = tries + 1
         deallocate (err)
         call stabilised_solve(model, asm, ls, fext*(at + step), at + step, opts, q, rep, err, &
                               unheld, contact)
         if (.not. allocated(err)) stabilised = stabilised + 1
+        if (allocated(err) .and. .not. unheld) damped = '; '//err%message   ! (told at the end)
       end if
       iters = iters + rep%iters
       if (allocated(err)) then
         if (level >= max_cuts .or. unheld) then   ! (a smaller load does not hold a body)
           err%message = 'static Newton did not converge at load factor '//rtoa(at + step)//' (after '// &
-                        itoa(level)//' halvings of the load step): '//err%message
+                        itoa(level)//' halvings of the load step): '//err%message//damped
           return
         end if
         level = level + 1   ! q is unchanged: half the increment
         deallocate (err)
         cycle
       end if
+      if (rep%factorisations == 0 .and. at + step >= to - 1e-12_dp*abs(to - from) .and. .not. opts%linear) &
+        call fresh_inertia(model, asm, ls, fext*to, to, opts, q, rep, iters, contact)   ! (this state's)
       if (present(contact)) call friction_step_done(contact, newmark_scheme(0._dp, 1._dp), before, &
                                                     static=.true.)   ! (s kept: friction_step_done)
       at = at + step
@@ -141,6 +144,29 @@ contains
     converging = .false.
     if (rep%nincr >= 2) converging = contraction(rep) < 0.1_dp
   end function converging
+
+  !> The inertia of the tangent at the converged state q (rep%neg_pivots), where the step
+  !> converged on factors kept from an earlier state: one Newton solve with fresh factors,
+  !> which starts within its tolerance. Kept factors would hide a buckling point: a column
+  !> at 1.5 times Euler's load took every step on the unloaded state's factors.
+  subroutine fresh_inertia(model, asm, ls, fext, factor, opts, q, rep, iters, contact)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    type(linear_system_t), intent(inout) :: ls
+    real(dp), intent(in) :: fext(:), factor
+    type(newton_opts_t), intent(in) :: opts
+    real(dp), intent(inout) :: q(:)
+    type(newton_report_t), intent(inout) :: rep
+    integer, intent(inout) :: iters   !< the load step's Newton iterations, this solve's added
+    type(contact_t), intent(inout), optional :: contact
+    type(newton_opts_t) :: fresh
+    type(newton_report_t) :: check
+    type(error_t), allocatable :: err
+    fresh = opts; fresh%reuse = .false.
+    call newton_solve(model, asm, ls, q, fext, fresh, check, err, contact=contact, load_factor=factor)
+    iters = iters + check%iters
+    if (.not. allocated(err)) rep%neg_pivots = check%neg_pivots   ! (else q as it was)
+  end subroutine fresh_inertia
 
   !> One load step through stabilised stages (module comment); unheld: a body kept moving.
   !> On failure q and the contact's active set are as they were at entry.
