@@ -229,7 +229,8 @@ contains
         'Reads DIR/history.dat (and DIR/tracked.txt), writes DIR/plots.gp and runs gnuplot on it', &
         'in DIR: positions_x|y|z.png, displacements.png, energy.png, momentum.png, contact.png,', &
         'newton.png; gnuplot''s messages go to DIR/gnuplot.log. Edit plots.gp and re-run', &
-        'gnuplot plots.gp in DIR to change them.', &
+        'gnuplot plots.gp in DIR to change them. A last line cut short (a run killed while', &
+        'writing it, a truncated copy) is left out with a warning; any other bad row is an error.', &
         'options:', &
         '  -h, --help        this text', &
         'exit codes: 0 plots written, 2 no readable history or gnuplot missing (plots.gp kept)']
@@ -390,6 +391,7 @@ contains
 
   subroutine cmd_plot()
     type(error_t), allocatable :: err
+    character(len=:), allocatable :: note
     logical :: missing
     if (wants_help()) then
       call command_help('plot'); return
@@ -399,7 +401,8 @@ contains
       code = exit_input; return
     end if
     if (.not. is_root()) return
-    call make_plots(arg(2), err, missing)
+    call make_plots(arg(2), err, missing, note=note)
+    if (allocated(note)) write (0, '(a)') 'warning: plot: '//note
     if (allocated(err)) then
       write (0, '(a)') 'error: plot: '//err%message
       code = exit_input

@@ -42,6 +42,10 @@ Asserted about the command line itself (issue 17):
   alike (the namelist read skipped it: a restraint vanished); '!' comments and blank lines
   between groups and after a '/' are accepted. A degenerate element is named with its body's
   deck line and mesh file; t_end = 1e300 is shown as 1.0000E+300 (was 1.0000+300).
+- `casca plot` of a history.dat whose last line is cut short (mid-row, or inside its last
+  number's exponent) exits 0 naming that line on stderr, and gnuplot reads the whole rows
+  before it alone (counted here); a field not a number or a short row mid-file, an empty file
+  and a missing one exit 2 naming the file (and line), with no Fortran traceback.
 Then the deck checks and a short run's output files (see the checks' names).
 
 usage: test_cli.py CASCA EXAMPLES_DIR MESH_DIR WORK_DIR
@@ -465,6 +469,60 @@ for f in glob.glob(os.path.join(work, "replot", "*.png")):
 p = run([casca, "plot", os.path.join(work, "replot")])
 ck.record("casca plot DIR remakes the plots", p.returncode == 0 and
           os.path.exists(os.path.join(work, "replot", "positions_x.png")))
+
+# --- casca plot of a damaged history.dat. Cut short in its last line (a run killed while
+# writing a row, a truncated copy): the whole rows are plotted, exit 0, and stderr names the
+# line left out; a row cut inside its last number, the exponent's digits gone, is left out too.
+# Anything else wrong (a field not a number, a short row mid-file, an empty file, none) is
+# refused, exit 2, naming the file (and the line), without a Fortran traceback. (Before
+# 2026-12: the cut row was plotted without a word, and a bad field mid-file too, exit 0.)
+def plot_of(name, text):
+    """casca plot of a folder holding text as its history.dat (none if text is None)."""
+    d = os.path.join(work, "plot_" + name)
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(d)
+    if text is not None:
+        with open(os.path.join(d, "history.dat"), "w") as f:
+            f.write(text)
+    return d, run([casca, "plot", d])
+
+
+def plotted_rows(d):
+    """The rows gnuplot reads through the folder's plots.gp (its datafile and rows)."""
+    g = subprocess.run(["gnuplot", "plots.gp", "-"], cwd=d, capture_output=True, text=True,
+                       input="set print '-'\nstats datafile @rows using 1 nooutput\nprint STATS_records\n")
+    return int(g.stdout.split()[-1]) if g.returncode == 0 and g.stdout.split() else -1
+
+
+def clean_refusal(p):
+    return p.returncode == 2 and "Backtrace" not in p.stderr and "Error termination" not in p.stderr
+
+
+lines = open(os.path.join(out, "history.dat")).read().splitlines(True)
+rows, n_last = len(lines) - 2, len(lines)   # whole rows before the last line, its line number
+last = lines[-1].rstrip("\n")
+for name, text in (("cut_mid_row", "".join(lines[:-1]) + last[:len(last) // 2]),
+                   ("cut_exponent", "".join(lines[:-1]) + last[:-2])):
+    d, p = plot_of(name, text)
+    ck.record("casca plot, history.dat %s: exit 0, its line %d named as left out on stderr" % (name, n_last),
+              p.returncode == 0 and "history.dat: line %d is cut short" % n_last in p.stderr
+              and "left out" in p.stderr, p.stderr.strip())
+    ck.record("casca plot, history.dat %s: gnuplot plots its %d whole rows" % (name, rows),
+              plotted_rows(d) == rows and os.path.exists(os.path.join(d, "energy.png")), str(plotted_rows(d)))
+bad = lines[3].split()
+bad[2] = "abc"
+d, p = plot_of("not_a_number", "".join(lines[:3]) + " ".join(bad) + "\n" + "".join(lines[4:]))
+ck.record("casca plot, a field not a number on line 4: exit 2 naming the file, line and column",
+          clean_refusal(p) and d + "/history.dat: line 4, column 3 (kinetic)" in p.stderr, p.stderr.strip())
+d, p = plot_of("short_mid_row", "".join(lines[:2]) + lines[2][:40] + "\n" + "".join(lines[3:]))
+ck.record("casca plot, a short row on line 3 of %d: exit 2 naming the file and line" % n_last,
+          clean_refusal(p) and d + "/history.dat: line 3: " in p.stderr, p.stderr.strip())
+d, p = plot_of("empty", "")
+ck.record("casca plot, an empty history.dat: exit 2 naming it",
+          clean_refusal(p) and d + "/history.dat is empty" in p.stderr, p.stderr.strip())
+d, p = plot_of("missing", None)
+ck.record("casca plot, no history.dat: exit 2 naming it",
+          clean_refusal(p) and d + "/history.dat" in p.stderr, p.stderr.strip())
 
 # --- gnuplot's warnings go to DIR/gnuplot.log, not the terminal
 out_c = os.path.join(work, "cantilever_out")

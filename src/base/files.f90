@@ -6,8 +6,8 @@ module casca_files
   use, intrinsic :: iso_fortran_env, only: int64
   implicit none
   private
-  public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line, file_kind, &
-            physical_memory, close_complete, folder_of
+  public :: rename_file, delete_file, make_dir, is_dir, cut_to_last_line, ends_in_newline, &
+            file_kind, physical_memory, close_complete, folder_of
   !> kinds of file_kind
   integer, parameter, public :: kind_missing = 0, kind_regular = 1, kind_folder = 2, kind_special = 3
 
@@ -78,6 +78,7 @@ contains
     character(len=*), intent(in) :: path
     character(len=:), allocatable :: text
     integer :: u, ios, n, stat
+    if (ends_in_newline(path)) return
     open (newunit=u, file=path, access='stream', form='unformatted', status='old', &
           action='read', iostat=ios)
     if (ios /= 0) return
@@ -86,9 +87,26 @@ contains
     if (n > 0) read (u, iostat=ios) text
     close (u)
     if (ios /= 0 .or. n <= 0) return
-    if (text(n:n) /= new_line('a')) stat = c_truncate(path//c_null_char, &
-                                                      int(index(text, new_line('a'), back=.true.), c_long))
+    stat = c_truncate(path//c_null_char, int(index(text, new_line('a'), back=.true.), c_long))
   end subroutine cut_to_last_line
+
+  !> Whether the text file path ends with a newline, as every line a writer finished does
+  !> (also for an empty file; .true. where it cannot be read: nothing to cut)
+  logical function ends_in_newline(path)
+    character(len=*), intent(in) :: path
+    character :: last
+    integer :: u, ios, n
+    ends_in_newline = .true.
+    open (newunit=u, file=path, access='stream', form='unformatted', status='old', &
+          action='read', iostat=ios)
+    if (ios /= 0) return
+    inquire (unit=u, size=n)
+    if (n > 0) then
+      read (u, pos=n, iostat=ios) last
+      if (ios == 0) ends_in_newline = last == new_line('a')
+    end if
+    close (u)
+  end function ends_in_newline
 
   !> kind_missing, kind_regular, kind_folder or kind_special (FIFO, device, socket) of the
   !> file path, and its size in bytes (64 bits)

@@ -1,7 +1,9 @@
 !> Time-history plots of a run, drawn by gnuplot from DIR/history.dat.
 !>
-!> make_plots reads only the header of history.dat (to learn the column numbers and the number
-!> K of tracked nodes), writes DIR/plots.gp and runs it with gnuplot inside DIR (gnuplot's
+!> make_plots reads the header of history.dat (to learn the column numbers and the number K of
+!> tracked nodes) and checks that every row below it holds a number for each of its names
+!> (gnuplot would skip a bad field, or read a number cut short as another), writes DIR/plots.gp
+!> and runs it with gnuplot inside DIR (gnuplot's
 !> messages go to DIR/gnuplot.log). The script names files relative to DIR and keeps the column
 !> numbers in variables at its top, so a user can edit it and re-run `gnuplot plots.gp` in the
 !> run folder without casca. Columns are looked up by name (not position), so extra columns
@@ -13,6 +15,7 @@ module casca_plots
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
   use casca_strings, only: itoa
+  use casca_files, only: ends_in_newline
   implicit none
   private
   public :: make_plots, plot_files
@@ -45,17 +48,21 @@ contains
   !> Write DIR/plots.gp from the header of DIR/history.dat and run gnuplot on it in DIR.
   !> If gnuplot is not installed this is not an error: gnuplot_missing (if present) is set
   !> .true. and the script is left for the user. A failing gnuplot run is an error.
-  subroutine make_plots(dir, err, gnuplot_missing, static)
+  !> A last line cut mid-row (a run killed while writing it, a truncated copy) is left out of
+  !> the plots, and note (if present) says so; a bad row anywhere else is an error.
+  subroutine make_plots(dir, err, gnuplot_missing, static, note)
     character(len=*), intent(in) :: dir
     type(error_t), allocatable, intent(out) :: err
     logical, intent(out), optional :: gnuplot_missing
     !> a static run (first column: the load factor); not given, one whose kinetic energy is
     !> 0 in every row (casca plot DIR, which has the history alone)
     logical, intent(in), optional :: static
+    !> what was left out of the plots, unallocated if nothing
+    character(len=:), allocatable, intent(out), optional :: note
 
     character(len=:), allocatable :: d, hist, script, cmd
-    type(word_t), allocatable :: labels(:)
-    integer :: col(nreq), nk, stat, cstat
+    type(word_t), allocatable :: labels(:), names(:)
+    integer :: col(nreq), nk, stat, cstat, rows, cut
     integer, allocatable :: pcol(:, :)
     character(len=msg_len) :: cmsg
     logical :: by_load
@@ -64,17 +71,22 @@ contains
     d = clean_dir(dir)
     hist = d//'/history.dat'
 
-    call read_header(hist, col, pcol, err)
+    call read_header(hist, names, col, pcol, err)
     if (allocated(err)) return
+    call check_rows(hist, names, rows, cut, err)
+    if (allocated(err)) return
+    if (cut > 0 .and. present(note)) note = hist//': line '//itoa(cut)//' is cut short (a run '// &
+      'killed while writing it, or a truncated copy) and was left out; plotted the '// &
+      itoa(rows)//' whole rows before it'
     nk = size(pcol, 2)
     call read_labels(d//'/tracked.txt', nk, labels)
 
     if (present(static)) then
       by_load = static
     else
-      by_load = at_rest(hist, col(findloc(req_names, 'kinetic', dim=1)))
+      by_load = at_rest(hist, col(findloc(req_names, 'kinetic', dim=1)), rows)
     end if
-    script = gnuplot_script(col, pcol, labels, by_load)
+    script = gnuplot_script(col, pcol, labels, by_load, rows, cut)
     call write_text(d//'/plots.gp', script, err)
     if (allocated(err)) return
 
@@ -98,18 +110,17 @@ contains
     end if
   end subroutine make_plots
 
-  !> Read the '#' header of path into the column numbers of the required columns (col) and of
-  !> the tracked-node columns pcol(1:6, 1:K); also check that one data row follows with as
-  !> many numbers as the header has names (else gnuplot would silently plot wrong columns).
-  subroutine read_header(path, col, pcol, err)
+  !> Read the '#' header of path into its column names, the column numbers of the required
+  !> columns (col) and of the tracked-node columns pcol(1:6, 1:K).
+  subroutine read_header(path, names, col, pcol, err)
     character(len=*), intent(in) :: path
+    type(word_t), allocatable, intent(out) :: names(:)
     integer, intent(out) :: col(nreq)
     integer, allocatable, intent(out) :: pcol(:, :)
     type(error_t), allocatable, intent(out) :: err
 
     character(len=:), allocatable :: line, head
     character(len=msg_len) :: msg
-    type(word_t), allocatable :: names(:)
     integer :: u, ios, i, j, k, nk, p
 
     allocate (pcol(6, 0))
@@ -168,36 +179,100 @@ contains
       end do
     end do
 
-    call read_line(u, line, ios)
     close (u)
-    if (ios /= 0) then
-      call fatal_error(err, 'make_plots: '//path//' has a header but no data rows')
-      return
-    end if
-    if (nwords(line) /= size(names)) then
-      call fatal_error(err, 'make_plots: '//path//': header names '//itoa(size(names)) &
-                       //' columns but row 1 has '//itoa(nwords(line)))
-      return
-    end if
   end subroutine read_header
 
-  !> Whether column c (the kinetic energy) of the history at path is 0 in every row
-  logical function at_rest(path, c)
+  !> Check the rows below the header of path (the lines not starting with '#', as gnuplot
+  !> reads them): each a number for each of the header's names. rows: how many there are
+  !> before cut, the line number of a last line cut short (0 if none): a line the writer
+  !> finished ends with a newline, and one without it may hold a number cut to another
+  !> (1.25e+03 cut to 1.25e+0), so it is left out whatever it holds.
+  subroutine check_rows(path, names, rows, cut, err)
     character(len=*), intent(in) :: path
-    integer, intent(in) :: c
+    type(word_t), intent(in) :: names(:)
+    integer, intent(out) :: rows, cut
+    type(error_t), allocatable, intent(out) :: err
+
+    character(len=:), allocatable :: line, what
+    type(word_t), allocatable :: w(:)
+    integer :: u, ios, n, last, bad
+    logical :: open_end
+
+    rows = 0; cut = 0; last = 0
+    open_end = .not. ends_in_newline(path)
+    open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios)
+    if (ios /= 0) then
+      call fatal_error(err, 'make_plots: cannot open '//path); return
+    end if
+    call read_line(u, line, ios)   ! (the header)
+    n = 1
+    do
+      call read_line(u, line, ios)
+      if (ios /= 0) exit
+      n = n + 1
+      if (index(adjustl(line), '#') == 1) cycle
+      w = split(line)
+      bad = not_a_number(w)
+      if (size(w) /= size(names)) then
+        what = ': '//itoa(size(w))//' fields where the header names '//itoa(size(names))
+      else if (bad > 0) then
+        what = ', column '//itoa(bad)//' ('//names(bad)%s//'): "'//w(bad)%s//'" is not a number'
+      else
+        rows = rows + 1; last = n
+        cycle
+      end if
+      call read_line(u, line, ios)
+      if (.not. (open_end .and. ios /= 0)) then   ! not a last line cut short
+        close (u)
+        call fatal_error(err, 'make_plots: '//path//': line '//itoa(n)//what)
+        return
+      end if
+      cut = n
+      exit
+    end do
+    close (u)
+    if (open_end .and. last == n) then   ! a whole row's fields, but cut short all the same
+      cut = n; rows = rows - 1
+    end if
+    if (rows == 0) then
+      what = ''
+      if (cut > 0) what = ' (line '//itoa(cut)//', cut short, is left out)'
+      call fatal_error(err, 'make_plots: '//path//' has a header but no data rows'//what)
+    end if
+  end subroutine check_rows
+
+  !> Index of the first of the words w that is not a number, 0 if none
+  integer function not_a_number(w) result(k)
+    type(word_t), intent(in) :: w(:)
+    real(dp) :: x
+    integer :: ios
+    do k = 1, size(w)
+      read (w(k)%s, *, iostat=ios) x
+      if (ios /= 0) return
+    end do
+    k = 0
+  end function not_a_number
+
+  !> Whether column c (the kinetic energy) of the history at path is 0 in its first rows rows
+  !> (the rows check_rows passed)
+  logical function at_rest(path, c, rows)
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: c, rows
     character(len=:), allocatable :: line
     type(word_t), allocatable :: w(:)
     real(dp) :: x
-    integer :: u, ios
+    integer :: u, ios, k
     at_rest = .false.
     open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios)
     if (ios /= 0) return
     call read_line(u, line, ios)   ! (the header)
-    do
+    k = 0
+    do while (k < rows)
       call read_line(u, line, ios)
       if (ios /= 0) exit
+      if (index(adjustl(line), '#') == 1) cycle
+      k = k + 1
       w = split(line)
-      if (size(w) < c) exit
       read (w(c)%s, *, iostat=ios) x
       if (ios /= 0 .or. x /= 0) then
         close (u); return
@@ -239,10 +314,11 @@ contains
 
   !> The gnuplot script. Column numbers go in variables at the top so the plot commands read
   !> by name; the terminal falls back to libgd `png` where cairo is not built in.
-  function gnuplot_script(col, pcol, labels, by_load) result(s)
+  function gnuplot_script(col, pcol, labels, by_load, rows, cut) result(s)
     integer, intent(in) :: col(nreq), pcol(:, :)
     type(word_t), intent(in) :: labels(:)
     logical, intent(in) :: by_load   !< a static run: against the load factor
+    integer, intent(in) :: rows, cut   !< the whole rows, and the line cut short after them (0: none)
     character(len=:), allocatable :: s
     character(len=:), allocatable :: x_of, x_label, versus
 
@@ -261,7 +337,17 @@ contains
     s = '# Time-history plots of a casca run, written by casca from the header of history.dat.' &
         //nl//'# Edit freely and re-run inside the run folder with:  gnuplot plots.gp'//nl// &
         '# history.dat is in SI units (s, m, J, N); time is plotted in ms.'//nl//nl// &
-        "datafile = 'history.dat'"//nl//nl//'# Column numbers in history.dat'//nl
+        "datafile = 'history.dat'"//nl
+    ! (a macro, as gnuplot's every takes no variable for 'to the end'; every counts the rows
+    ! from 0, the header and '#' lines left out)
+    if (cut > 0) then
+      s = s//'# line '//itoa(cut)//' of history.dat was cut short (a run killed while writing '// &
+          'it, or a truncated copy): only the '//itoa(rows)//' whole rows before it are plotted'// &
+          nl//"rows = 'every ::0::"//itoa(rows - 1)//"'"//nl
+    else
+      s = s//"rows = ''   # every row; 'every ::0::N' plots rows 0 to N only"//nl
+    end if
+    s = s//nl//'# Column numbers in history.dat'//nl
     do i = 1, nreq
       s = s//'c_'//trim(req_names(i))//' = '//itoa(col(i))//nl
     end do
@@ -314,7 +400,7 @@ contains
         do k = 1, nk
           v = 'c_p'//itoa(k)//'_'//axis(a)
           if (k > 1) s = s//', \'//nl//'     '
-          s = s//"datafile using (ms(c_t)):(column("//v//")) with lines lt "//itoa(k) &
+          s = s//"datafile @rows using (ms(c_t)):(column("//v//")) with lines lt "//itoa(k) &
               //" title '"//gp_quote(labels(k)%s)//"'"
         end do
         s = s//nl//nl
@@ -333,7 +419,7 @@ contains
         do k = 1, nk
           v = 'c_p'//itoa(k)//'_'//axis(a)
           if (k > 1) s = s//', \'//nl//'     '
-          s = s//"datafile using (ms(c_t)):($0 == 0 ? (u0 = column("//v//"), 0) : column("//v// &
+          s = s//"datafile @rows using (ms(c_t)):($0 == 0 ? (u0 = column("//v//"), 0) : column("//v// &
               ") - u0) with lines lt "//itoa(k)//" title '"//gp_quote(labels(k)%s)//"'"
         end do
         s = s//nl
@@ -347,10 +433,10 @@ contains
         "set output 'energy.png'"//nl// &
         "set title 'Energies"//versus//"'"//nl// &
         "set ylabel 'energy [J]'"//nl// &
-        "plot datafile using (ms(c_t)):(column(c_kinetic)) with lines lt 1 title 'kinetic', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_strain)) with lines lt 2 title 'strain', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_work)) with lines lt 3 title 'work', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_total)) with lines lt 4 title 'total'"//nl//nl
+        "plot datafile @rows using (ms(c_t)):(column(c_kinetic)) with lines lt 1 title 'kinetic', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_strain)) with lines lt 2 title 'strain', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_work)) with lines lt 3 title 'work', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_total)) with lines lt 4 title 'total'"//nl//nl
 
     s = s//'# Linear (top) and angular (bottom) momentum'//nl// &
         'set terminal @term size 1000,800'//nl// &
@@ -358,22 +444,22 @@ contains
         "set multiplot layout 2,1 title 'Momentum"//versus//"' font ',15'"//nl// &
         "set title 'linear momentum'"//nl// &
         "set ylabel 'p [kg"//mdot//"m/s]'"//nl// &
-        "plot datafile using (ms(c_t)):(column(c_px)) with lines lt 1 title 'px', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_py)) with lines lt 2 title 'py', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_pz)) with lines lt 3 title 'pz'"//nl// &
+        "plot datafile @rows using (ms(c_t)):(column(c_px)) with lines lt 1 title 'px', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_py)) with lines lt 2 title 'py', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_pz)) with lines lt 3 title 'pz'"//nl// &
         "set title 'angular momentum (about the origin)'"//nl// &
         "set ylabel 'L [kg"//mdot//"m"//sup2//"/s]'"//nl// &
-        "plot datafile using (ms(c_t)):(column(c_Lx)) with lines lt 1 title 'Lx', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_Ly)) with lines lt 2 title 'Ly', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_Lz)) with lines lt 3 title 'Lz'"//nl// &
+        "plot datafile @rows using (ms(c_t)):(column(c_Lx)) with lines lt 1 title 'Lx', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_Ly)) with lines lt 2 title 'Ly', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_Lz)) with lines lt 3 title 'Lz'"//nl// &
         'unset multiplot'//nl// &
         'set terminal @term size 1000,600'//nl//nl
 
     ! Counts are integers: integer tick steps, and a y range that starts at 0 and is not empty
     ! when nothing is in contact (gnuplot would warn about an empty range).
     s = s//'# Contact: number of active contacts (left axis), total contact force (right axis)'//nl// &
-        "stats datafile using c_contacts nooutput name 'CONT'"//nl// &
-        "stats datafile using c_fcontact nooutput name 'FCON'"//nl// &
+        "stats datafile @rows using c_contacts nooutput name 'CONT'"//nl// &
+        "stats datafile @rows using c_fcontact nooutput name 'FCON'"//nl// &
         "set output 'contact.png'"//nl// &
         "set title 'Contact"//versus//"'"//nl// &
         "set ylabel 'active contacts [-]' textcolor lt 1"//nl// &
@@ -387,19 +473,20 @@ contains
         '}'//nl// &
         'set y2tics'//nl// &
         'set grid noy2tics'//nl// &
-        "plot datafile using (ms(c_t)):(column(c_contacts)) with steps lt 1 title 'active contacts (left axis)', \"//nl// &
-        "     datafile using (ms(c_t)):(column(c_fcontact)) axes x1y2 with lines lt 2 title 'contact force (right axis)'"//nl// &
+        "plot datafile @rows using (ms(c_t)):(column(c_contacts)) with steps lt 1 title 'active contacts (left axis)', \"//nl// &
+        "     datafile @rows using (ms(c_t)):(column(c_fcontact)) axes x1y2 with lines lt 2 "// &
+        "title 'contact force (right axis)'"//nl// &
         'unset y2tics; unset y2label; set ylabel textcolor default'//nl// &
         'set ytics mirror autofreq; set yrange [*:*]'//nl//nl
 
     s = s//'# Newton iterations per time step'//nl// &
-        "stats datafile using c_newton nooutput name 'NEWT'"//nl// &
+        "stats datafile @rows using c_newton nooutput name 'NEWT'"//nl// &
         "set output 'newton.png'"//nl// &
         "set title 'Newton iterations per time step'"//nl// &
         "set ylabel 'Newton iterations [-]'"//nl// &
         'set yrange [0:imax(1, NEWT_max+1)]'//nl// &
         'set ytics imax(1, ceil(NEWT_max/10.0))'//nl// &
-        "plot datafile using (ms(c_t)):(column(c_newton)) with steps lt 1 title 'iterations'"//nl// &
+        "plot datafile @rows using (ms(c_t)):(column(c_newton)) with steps lt 1 title 'iterations'"//nl// &
         'set ytics autofreq; set yrange [*:*]'//nl// &
         'unset output'//nl
   end function gnuplot_script
@@ -466,19 +553,6 @@ contains
       if (pass == 1) allocate (w(n))
     end do
   end function split
-
-  !> Number of words split(line) would return.
-  pure integer function nwords(line)
-    character(len=*), intent(in) :: line
-    integer :: i
-    logical :: prev_space
-    nwords = 0
-    prev_space = .true.
-    do i = 1, len(line)
-      if (prev_space .and. .not. is_space(line(i:i))) nwords = nwords + 1
-      prev_space = is_space(line(i:i))
-    end do
-  end function nwords
 
   pure logical function is_space(c)
     character(len=1), intent(in) :: c
