@@ -60,10 +60,19 @@ denser target  a thin tube (R 40 mm, width 120 mm, 16 x 3 cells) listed as the t
                (0.3 m, 8 x 8 cells): the warning gives the plate's area per node over the tube's,
                (0.3^2 / 25^2) / (2 pi R w / (48 x 10)) = 2.29, within 1%; listed the other way
                round, or with passes = 2, no such warning.
+run time      `casca check`'s run time against the CPU time of the run itself (one rank; CPU, not
+               wall, so that other jobs on the machine do not move it), within a factor of 3 (the
+               line says about 2): a ball (R 50 mm, h 2 mm, 180 elements) let go at rest in a
+               rough rigid bowl (R 0.3 m) under gravity and tolerance 1e-4, 20 ms (7.4 s measured;
+               before 2026-12 the estimate was 0.11 to 0.29 s: t_end / dt = 20 steps at 0.03 to
+               0.08 ms an element, where the run took 94 steps of 5 to 6 Newton iterations and a
+               factorisation nearly every step), and the thesis rings' impact (examples/two_rings.nml), its
+               first 10 ms.
 """
 import math
 import os
 import re
+import resource
 import sys
 
 from casca_testlib import Checks, run
@@ -318,4 +327,34 @@ for name, contact, warned in (("coarse_impactor", "pairs = 'plate', 'tube'", Tru
     else:
         ck.record("%s: no warning of denser target nodes" % name, m is None and p.returncode == 0,
                   p.stderr[-300:])
+
+# --- the run time casca check gives against the run's own CPU time
+def cpu_of_children():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+for name, text in (("bowl_rolling", """&run dt = 1.0e-3, t_end = 0.02, tolerance = 1.0e-4, gravity = 0.0, 0.0, -9.81 /
+&output interval = 0.01, vtu = .false., plots = .false. /
+&body name = 'ball', mesh = 'sphere', radius = 0.05, n_div = 3, center = 0.0851288, 0.0, -0.2338895,
+  young = 210e9, poisson = 0.3, density = 7850, thickness = 0.002 /
+&obstacle name = 'bowl', shape = 'sphere', point = 0.0, 0.0, 0.0, radius = 0.3, inside = .true.,
+  friction = 0.3 /
+"""), ("rings_impact", f"""&run dt = 5.0e-5, t_end = 1.0e-2, beta = 1.0, gamma = 1.5 /
+&output vtu = .false., plots = .false. /
+&body name = 'ring1', mesh = 'file', file = '{ring}', velocity = 10.0, 0.0, 0.0, {STEEL}, thickness = {h} /
+&body name = 'ring2', mesh = 'file', file = '{ring}', center = 2.01, 0.0, 0.0, {STEEL}, thickness = {h} /
+&contact surface = 'mid', pairs = 'ring1', 'ring2' /
+""")):
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text)
+    m = re.search(r"^run time: ~\s*(\S+)", run([casca, "check", deck]).stdout, re.M)
+    cpu = cpu_of_children()
+    p = run([casca, "run", deck, "--out", os.path.join(work, name), "-q"])
+    cpu = cpu_of_children() - cpu
+    ok = m is not None and p.returncode == 0
+    ck.record("%s: casca check's run time %s s against the run's CPU time %.3g s, within a factor 3"
+              % (name, m.group(1) if m else "(none)", cpu),
+              ok and 1 / 3 <= float(m.group(1)) / cpu <= 3, "" if ok else p.stderr[-300:])
 ck.finish()

@@ -339,27 +339,119 @@ contains
       '36 kB measured on a sphere of 11,520 elements, with a margin; docs/performance.md)'
   end subroutine memory_line
 
-  !> A rough run time: the steps at the deck's dt times the elements times 0.03 to 0.08 ms
-  !> per element and step, what whole runs took on one rank of a 2-core machine (three
-  !> spheres 0.032 ms: 2,160 elements, 3,334 steps, 228 s; two rings 0.075 ms: 80 elements,
-  !> 800 steps, 6 s; docs/performance.md). Contact, Newton's iterations and the machine
-  !> move it by a factor of two either way on impacts; a tube crushed on 300 to 430 contacts
-  !> (validator, 2026-11-29) took 23 to 60 times the estimate.
+  !> A rough run time on one rank: steps x (Newton iterations x (c_call + c_elem x elements)
+  !> + factorisations x c_fact x the sum over the bodies of n^1.5, n a body's unknowns), on
+  !> what the deck says of its steps and contacts (docs/performance.md, "casca check's run
+  !> time"). The former figure, the steps at dt times 0.03 to 0.08 ms per element, held for
+  !> impacts (thesis rings and spheres) and was 5 to 180 times low where contacts work every
+  !> step: a hoop rolling with friction (5 Newton iterations a step, a new factorisation every
+  !> other one), a ball rolling in a bowl under tolerance (769 steps for t_end / dt = 100, a
+  !> factorisation nearly every step: 172 s for 1 to 2.6).
   subroutine time_line(deck, model, u)
     type(deck_t), intent(in) :: deck
     type(model_t), intent(in) :: model
     integer, intent(in) :: u
-    real(dp) :: work
-    work = deck%run%t_end/deck%run%dt*model%nelem
-    write (u, '(a)') 'run time: ~ '//rtoa(0.03e-3_dp*work)//' to '//rtoa(0.08e-3_dp*work)// &
-      ' s on one rank for t_end / dt = '//rtoa(deck%run%t_end/deck%run%dt)//' steps of '// &
-      count_of(model%nelem, 'element', 'elements')//' (0.03 to 0.08 ms per element and step, '// &
-      'measured on impacts; contact and Newton move it by 2x either way, and a crush on '// &
-      'hundreds of contacts, Newton taking 8 to 20 iterations a step, took 20 to 60 times more'// &
-      trim(merge('; with tolerance the steps are chosen as the run goes', &
-                 '                                                     ', &
-                 deck%run%tolerance /= unset))//')'
+    !> a Newton iteration: s, and s per element (3.0 to 20.5 ms of CPU measured on 80 to 320
+    !> elements: two rings, a hoop rolling, a ball on a compliant floor, a ball in a bowl); a
+    !> factorisation: s per n^1.5 (0.13 to 0.15 s for a sphere's 10,094 unknowns, 17 ms for a
+    !> hoop's 3,360)
+    real(dp), parameter :: c_call = 2e-3_dp, c_elem = 20e-6_dp, c_fact = 1.3e-7_dp
+    character(len=:), allocatable :: busy, steps_why, fact_why
+    integer :: newton, b
+    real(dp) :: steps, facts, n15, hi, lo, iter, total
+    busy = busy_contact(deck, model)
+    ! the steps: with tolerance chosen as the run goes, on the grid of the frame interval
+    ! halved; while contacts work, between the longest at most dt (after a contact begins)
+    ! and the shortest, dt / 2^max_step_cuts: their geometric mean
+    steps = deck%run%t_end/deck%run%dt
+    steps_why = 'steps (t_end / dt)'
+    if (deck%run%tolerance /= unset) then
+      steps_why = 'steps (t_end / dt; tolerance chooses them as the run goes, longer while no '// &
+                  'contact works)'
+      if (busy /= '') then
+        hi = frame_interval(deck)
+        do while (hi > deck%run%dt)
+          hi = hi/2
+        end do
+        lo = hi
+        do while (lo > deck%run%dt/2**deck%run%max_step_cuts)
+          lo = lo/2
+        end do
+        steps = deck%run%t_end/sqrt(hi*lo)
+        steps_why = 'steps of '//rtoa(sqrt(hi*lo))//' s (tolerance chooses them; while contacts '// &
+                    'work they lie between '//rtoa(lo)//' and '//rtoa(hi)//' s: assumed at their '// &
+                    'geometric mean)'
+      end if
+    end if
+    newton = merge(5, 2, busy /= '')
+    if (deck%run%tolerance /= unset) then
+      facts = 1; fact_why = 'every step (its length changes)'
+    else if (index(busy, 'friction') > 0) then
+      facts = 0.5_dp; fact_why = 'every other step (stick and slip turn)'
+    else
+      facts = 0.01_dp; fact_why = 'every 100th step (the factors kept)'
+    end if
+    n15 = 0
+    do b = 1, model%nbody
+      associate (bd => model%body(b))
+        n15 = n15 + real(count(.not. model%fixed(dof(bd%node_first, 1):dof(bd%node_last, 7))), dp)**1.5_dp
+      end associate
+    end do
+    iter = c_call + c_elem*model%nelem
+    total = steps*(newton*iter + facts*c_fact*n15)
+    if (busy == '') busy = 'no contact working every step'
+    write (u, '(a)') 'run time: ~ '//rtoa(total)//' s on one idle core, within about 2x where '// &
+      'these hold: '//rtoa(steps)//' '//steps_why//'; '//itoa(newton)//' Newton iterations a '// &
+      'step ('//busy//'; 5 where friction, a compliant contact or a body lying on its contact '// &
+      'works every step, else 2) at '//rtoa(iter)//' s ('//rtoa(c_call)//' s + '//rtoa(c_elem)// &
+      ' s x '//count_of(model%nelem, 'element', 'elements')//'); a factorisation '//fact_why// &
+      ' at '//rtoa(c_fact*n15)//' s ('//rtoa(c_fact)//' s x n^1.5 for n unknowns a body); '// &
+      'contacts by the hundred '// &
+      '(a crush) cost more, bodies idle in free flight less'
   end subroutine time_line
+
+  !> Why the deck's contacts work every step, '' if they need not: friction, a compliant
+  !> contact (its depth changes in every step), or a body lying on its contact (within the
+  !> band a step detects) under gravity or a load
+  function busy_contact(deck, model) result(why)
+    type(deck_t), intent(in) :: deck
+    type(model_t), intent(in) :: model
+    character(len=:), allocatable :: why
+    type(contact_t) :: c
+    type(state_t) :: st
+    type(pair_gap_t), allocatable :: pg(:)
+    integer :: p, bi, bt
+    logical :: found, pressed
+    why = ''
+    call scene_contact(deck, model, c, found)
+    if (.not. found) return
+    if (any(c%mu_s > 0) .or. any(c%mu_d > 0)) then
+      why = 'friction'
+    else if (deck%contact%stiffness /= unset) then
+      why = 'a compliant contact'
+    else
+      call initial_state(deck, model, st)
+      pg = pair_gaps_at(c, model, st%q, st%qd)
+      do p = 1, c%npairs
+        bi = c%pair(1, p); bt = c%pair(2, p)
+        if (bi == bt .or. pg(p)%gap > search_radius(c, model, bi, bt)) cycle
+        pressed = driven(model, bi)
+        if (bt > 0) pressed = pressed .or. driven(model, bt)
+        if (pressed) then
+          why = 'a body lying on its contact'; return
+        end if
+      end do
+    end if
+  end function busy_contact
+
+  !> Whether gravity or a load acts on body b
+  logical function driven(model, b)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    associate (bd => model%body(b))
+      driven = any(bd%gravity /= 0) .or. any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0)
+    end associate
+  end function driven
 
   !> Normals into a closed body, distorted elements, edges of three elements or more
   function body_warnings(model, f) result(w)
@@ -412,10 +504,7 @@ contains
     call initial_state(deck, model, st)
     pg = pair_gaps_at(c, model, st%q, st%qd)
     do bi = 1, model%nbody
-      associate (bd => model%body(bi))
-        pushed(bi) = any(bd%gravity /= 0) .or. &
-                     any(model%fext(dof(bd%node_first, 1):dof(bd%node_last, 7)) /= 0)
-      end associate
+      pushed(bi) = driven(model, bi)
     end do
     do p = 1, c%npairs
       if (pg(p)%time < 0 .or. c%pair(1, p) == c%pair(2, p)) cycle
