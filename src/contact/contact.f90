@@ -141,14 +141,10 @@ module casca_contact
     !> its nodes slipping and sticking again a batch at a time, ran out of decisions)
     integer :: decisions = 0
     !> the sets this solve has settled into (active_set.f90's set_key), and whether it came
-    !> back to one of them: then tensile constraints go one at a time, and nodes arriving
-    !> with a slip Coulomb cannot stop come in sliding
+    !> back to one of them: then tensile constraints go one at a time
     integer(i8) :: seen(2, 16) = 0
     integer :: nseen = 0
     logical :: cycling = .false.
-    !> the constraints (node, pair: set_key's number) released in this solve: one taken again
-    !> has cycled by itself, and comes in sliding as in a cycling set
-    integer(i8), allocatable :: gone(:)
   end type active_set_t
 
   !> A contact problem: its options, pairs and obstacles, the targets' geometry, the active
