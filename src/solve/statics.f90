@@ -74,8 +74,7 @@ contains
     integer :: tries   !< stabilised solves tried (module comment)
     type(constraint_t), allocatable :: before(:)
     character(len=:), allocatable :: damped   !< how the stabilised path failed ('': it did not)
-    at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tries = 0; probed = .false.
-    damped = ''
+    at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tries = 0; probed = .false.; damped = ''
     if (present(contact)) contact%opt%stick_at_touch = .true.
     do while (at < to - 1e-12_dp*abs(to - from))
       step = min((to - from)/2**level, to - at)
@@ -106,9 +105,8 @@ contains
       if (allocated(err) .and. probed .and. tries == 0) then   ! (what is left, as below)
         level = 0; step = to - at
       end if
-      ! (stabilised on the step and its first half only: a sphere past its buckling pressure
-      ! spent 55 s more at every halving; a hemisphere whose whole load was too far stopped
-      ! at 1/16 of it without the half's, which took it through as two load steps do)
+      ! (stabilised on the step and its first half only: a buckled sphere spent 55 s more at
+      ! every halving; a hemisphere whose whole load was too far needed the half's)
       if (allocated(err) .and. (tries == 0 .or. (tries == 1 .and. level == 1))) then
         iters = iters + rep%iters; tries = tries + 1
         deallocate (err)
