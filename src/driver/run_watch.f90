@@ -238,11 +238,11 @@ contains
     character(len=:), allocatable :: at
     integer :: b
     if (.not. allocated(r%contact) .or. r%sink_node == 0) return
-    at = 'at t = '//rtoa(r%t_sink)//' s'
-    if (r%deck%run%analysis == 'static') at = 'at load factor '//rtoa(r%t_sink)
     if (r%contact%opt%compliant) return   ! (a spring's depth is its force over its stiffness)
     b = r%model%node_body(r%sink_node)
     if (r%sink <= 0.1_dp*r%model%body(b)%thickness) return
+    at = 'at t = '//rtoa(r%t_sink)//' s'
+    if (r%deck%run%analysis == 'static') at = 'at load factor '//rtoa(r%t_sink)
     write (0, '(a)') 'warning: a contact node of body '''//trim(r%model%body(b)%name)//''' sank '// &
       rtoa(r%sink)//' m ('//itoa(nint(100*r%sink/r%model%body(b)%thickness))//'% of its thickness) '// &
       'into its target '//at//' (its node '// &

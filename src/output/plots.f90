@@ -65,7 +65,7 @@ contains
     integer :: col(nreq), nk, stat, cstat, rows, cut
     integer, allocatable :: pcol(:, :)
     character(len=msg_len) :: cmsg
-    logical :: by_load
+    logical :: by_load, still
 
     if (present(gnuplot_missing)) gnuplot_missing = .false.
     d = clean_dir(dir)
@@ -73,7 +73,7 @@ contains
 
     call read_header(hist, names, col, pcol, err)
     if (allocated(err)) return
-    call check_rows(hist, names, rows, cut, err)
+    call check_rows(hist, names, col(findloc(req_names, 'kinetic', dim=1)), rows, cut, still, err)
     if (allocated(err)) return
     if (cut > 0 .and. present(note)) note = hist//': line '//itoa(cut)//' is cut short (a run '// &
       'killed while writing it, or a truncated copy) and was left out; plotted the '// &
@@ -84,7 +84,7 @@ contains
     if (present(static)) then
       by_load = static
     else
-      by_load = at_rest(hist, col(findloc(req_names, 'kinetic', dim=1)), rows)
+      by_load = still
     end if
     script = gnuplot_script(col, pcol, labels, by_load, rows, cut)
     call write_text(d//'/plots.gp', script, err)
@@ -186,19 +186,23 @@ contains
   !> reads them): each a number for each of the header's names. rows: how many there are
   !> before cut, the line number of a last line cut short (0 if none): a line the writer
   !> finished ends with a newline, and one without it may hold a number cut to another
-  !> (1.25e+03 cut to 1.25e+0), so it is left out whatever it holds.
-  subroutine check_rows(path, names, rows, cut, err)
+  !> (1.25e+03 cut to 1.25e+0), so it is left out whatever it holds. still: column kin (the
+  !> kinetic energy) is 0 in every one of those rows (read in the same pass).
+  subroutine check_rows(path, names, kin, rows, cut, still, err)
     character(len=*), intent(in) :: path
     type(word_t), intent(in) :: names(:)
+    integer, intent(in) :: kin
     integer, intent(out) :: rows, cut
+    logical, intent(out) :: still
     type(error_t), allocatable, intent(out) :: err
 
     character(len=:), allocatable :: line, what
     type(word_t), allocatable :: w(:)
-    integer :: u, ios, n, last, bad
+    real(dp) :: x
+    integer :: u, ios, n, last, bad, moving
     logical :: open_end
 
-    rows = 0; cut = 0; last = 0
+    rows = 0; cut = 0; last = 0; moving = 0; still = .false.
     open_end = .not. ends_in_newline(path)
     open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios)
     if (ios /= 0) then
@@ -219,6 +223,8 @@ contains
         what = ', column '//itoa(bad)//' ('//names(bad)%s//'): "'//w(bad)%s//'" is not a number'
       else
         rows = rows + 1; last = n
+        read (w(kin)%s, *) x
+        if (x /= 0 .and. moving == 0) moving = n
         cycle
       end if
       call read_line(u, line, ios)
@@ -234,6 +240,7 @@ contains
     if (open_end .and. last == n) then   ! a whole row's fields, but cut short all the same
       cut = n; rows = rows - 1
     end if
+    still = moving == 0 .or. moving == cut
     if (rows == 0) then
       what = ''
       if (cut > 0) what = ' (line '//itoa(cut)//', cut short, is left out)'
@@ -252,35 +259,6 @@ contains
     end do
     k = 0
   end function not_a_number
-
-  !> Whether column c (the kinetic energy) of the history at path is 0 in its first rows rows
-  !> (the rows check_rows passed)
-  logical function at_rest(path, c, rows)
-    character(len=*), intent(in) :: path
-    integer, intent(in) :: c, rows
-    character(len=:), allocatable :: line
-    type(word_t), allocatable :: w(:)
-    real(dp) :: x
-    integer :: u, ios, k
-    at_rest = .false.
-    open (newunit=u, file=path, status='old', action='read', form='formatted', iostat=ios)
-    if (ios /= 0) return
-    call read_line(u, line, ios)   ! (the header)
-    k = 0
-    do while (k < rows)
-      call read_line(u, line, ios)
-      if (ios /= 0) exit
-      if (index(adjustl(line), '#') == 1) cycle
-      k = k + 1
-      w = split(line)
-      read (w(c)%s, *, iostat=ios) x
-      if (ios /= 0 .or. x /= 0) then
-        close (u); return
-      end if
-      at_rest = .true.
-    end do
-    close (u)
-  end function at_rest
 
   !> Labels of the tracked nodes: line k of path (tracked.txt), or "node k" if the file or
   !> the line is missing or blank.
