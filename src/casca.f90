@@ -27,7 +27,7 @@ program casca
   use casca_deck, only: deck_t, body_cfg_t, counts_for_size, unset
   use casca_model, only: model_t
   use casca_mesh, only: mesh_t
-  use casca_mesh_generators, only: mesh_ring, mesh_sphere, mesh_plate
+  use casca_mesh_generators, only: generated_mesh
   use casca_gmsh_io, only: write_gmsh
   use casca_plots, only: make_plots
   use casca_starter, only: starter_report
@@ -369,18 +369,7 @@ contains
       if (is_root()) write (0, '(a)') 'error: mesh: give the output file with -o FILE.msh'
       code = exit_input; return
     end if
-    select case (b%mesh)
-    case ('ring')
-      call mesh_ring(b%radius, b%width, b%n_around, b%n_across, mesh, err)
-    case ('sphere')
-      call mesh_sphere(b%radius, b%n_div, mesh, err)
-    case ('plate', 'strip')
-      call mesh_plate(b%lx, b%ly, b%nx, b%ny, mesh, err)
-    case default
-      if (is_root()) write (0, '(a)') 'error: mesh: unknown kind "'//trim(b%mesh)// &
-        '" (ring, sphere, plate, strip)'
-      code = exit_input; return
-    end select
+    call generated_mesh(b, mesh, err)
     if (.not. allocated(err) .and. is_root()) call write_gmsh(out, mesh, err)
     if (allocated(err)) then
       if (is_root()) write (0, '(a)') 'error: mesh: '//err%message

@@ -3,9 +3,9 @@
 module casca_sanity
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
   use casca_kinds, only: dp
-  use casca_deck, only: deck_t, obstacle_cfg_t, add_problem, unset, deck_file, max_track
+  use casca_deck, only: deck_t, body_cfg_t, obstacle_cfg_t, add_problem, unset, deck_file, max_track
   use casca_files, only: file_kind, kind_missing, kind_regular, physical_memory
-  use casca_mesh_generators, only: generated_elements, max_generated_elements
+  use casca_mesh_generators, only: body_elements, max_generated_elements
   use casca_strings, only: itoa, rtoa, as_word
   use casca_deck_lint, only: did_you_mean
   implicit none
@@ -138,17 +138,14 @@ contains
           call positive(n, '&body '//trim(b%name)//': width', b%width)
           if (b%n_around < 3 .or. b%n_across < 1) call add_problem(deck, n, '&body '// &
             trim(b%name)//': ring needs n_around >= 3 and n_across >= 1')
-          call check_size(n, b%name, b%mesh, b%n_around, b%n_across)
         case ('sphere')
           call positive(n, '&body '//trim(b%name)//': radius', b%radius)
           if (b%n_div < 1) call add_problem(deck, n, '&body '//trim(b%name)//': n_div must be >= 1')
-          call check_size(n, b%name, b%mesh, b%n_div, 0)
         case ('plate', 'strip')
           call positive(n, '&body '//trim(b%name)//': lx', b%lx)
           call positive(n, '&body '//trim(b%name)//': ly', b%ly)
           if (b%nx < 1 .or. b%ny < 1) call add_problem(deck, n, '&body '//trim(b%name)// &
             ': nx and ny must be >= 1')
-          call check_size(n, b%name, b%mesh, b%nx, b%ny)
         case ('file')
           if (b%file == '') then
             call add_problem(deck, n, '&body '//trim(b%name)//': mesh = ''file'' needs file = ...')
@@ -167,6 +164,7 @@ contains
           call add_problem(deck, n, '&body '//trim(b%name)//': unknown mesh '''//trim(b%mesh)// &
                            ''' (ring, sphere, plate, strip or file)')
         end select
+        call check_size(n, b)
       end associate
     end do
 
@@ -389,11 +387,11 @@ contains
     end subroutine finite
 
     !> a generator's sizes must give at most max_generated_elements
-    subroutine check_size(line, name, kind, n1, n2)
-      integer, intent(in) :: line, n1, n2
-      character(len=*), intent(in) :: name, kind
-      if (generated_elements(kind, n1, n2) > max_generated_elements) call add_problem(deck, &
-        line, '&body '//trim(name)//': the sizes give '//rtoa(generated_elements(kind, n1, n2))// &
+    subroutine check_size(line, b)
+      integer, intent(in) :: line
+      type(body_cfg_t), intent(in) :: b
+      if (body_elements(b) > max_generated_elements) call add_problem(deck, line, '&body '// &
+        trim(b%name)//': the sizes give '//rtoa(body_elements(b))// &
         ' elements, more than the 1e7 a generator makes')
     end subroutine check_size
 
@@ -403,16 +401,7 @@ contains
       integer :: k
       elems = 0
       do k = 1, size(deck%bodies)
-        associate (b => deck%bodies(k))
-          select case (b%mesh)
-          case ('ring')
-            elems(k) = generated_elements(b%mesh, b%n_around, b%n_across)
-          case ('sphere')
-            elems(k) = generated_elements(b%mesh, b%n_div, 0)
-          case ('plate', 'strip')
-            elems(k) = generated_elements(b%mesh, b%nx, b%ny)
-          end select
-        end associate
+        elems(k) = body_elements(deck%bodies(k))
       end do
       if (size(elems) == 0 .or. physical_memory() <= 0) return
       if (sum(elems)*bytes_per_element > real(physical_memory(), dp)) &   ! (at the largest body)

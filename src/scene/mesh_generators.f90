@@ -12,9 +12,10 @@ module casca_mesh_generators
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen
   use casca_vectors, only: cross
+  use casca_deck, only: body_cfg_t
   implicit none
   private
-  public :: mesh_ring, mesh_sphere, mesh_plate, generated_elements
+  public :: mesh_ring, mesh_sphere, mesh_plate, generated_mesh, body_elements
 
   !> Most elements a generator makes: beyond it the lattice indices (3n+1)^2 leave 32 bits
   !> and no machine would hold the model anyway
@@ -26,6 +27,39 @@ module casca_mesh_generators
   integer, parameter :: node_b(nen) = [0, 0, 3, 0, 0, 1, 2, 2, 1, 1]
 
 contains
+
+  !> The mesh generator b%mesh (ring, sphere, plate, strip) makes from body b's sizes; an error
+  !> for any other kind.
+  subroutine generated_mesh(b, mesh, err)
+    type(body_cfg_t), intent(in) :: b
+    type(mesh_t), intent(out) :: mesh
+    type(error_t), allocatable, intent(out) :: err
+    select case (b%mesh)
+    case ('ring')
+      call mesh_ring(b%radius, b%width, b%n_around, b%n_across, mesh, err)
+    case ('sphere')
+      call mesh_sphere(b%radius, b%n_div, mesh, err)
+    case ('plate', 'strip')
+      call mesh_plate(b%lx, b%ly, b%nx, b%ny, mesh, err)
+    case default
+      call fatal_error(err, 'unknown kind "'//trim(b%mesh)//'" (ring, sphere, plate, strip)')
+    end select
+  end subroutine generated_mesh
+
+  !> Number of elements body b's generator makes from its sizes; 0 for a mesh file.
+  pure real(dp) function body_elements(b) result(n)
+    type(body_cfg_t), intent(in) :: b
+    select case (b%mesh)
+    case ('ring')
+      n = generated_elements(b%mesh, b%n_around, b%n_across)
+    case ('sphere')
+      n = generated_elements(b%mesh, b%n_div, 0)
+    case ('plate', 'strip')
+      n = generated_elements(b%mesh, b%nx, b%ny)
+    case default
+      n = 0
+    end select
+  end function body_elements
 
   !> Number of elements the generator kind ('ring', 'sphere', 'plate', 'strip') makes from
   !> its sizes (n1, n2) = (n_around, n_across), (n_div, -) or (nx, ny); in real arithmetic,

@@ -4,7 +4,7 @@ module casca_scene
   use casca_kinds, only: dp
   use casca_error, only: error_t
   use casca_mesh, only: mesh_t
-  use casca_mesh_generators, only: mesh_ring, mesh_sphere, mesh_plate
+  use casca_mesh_generators, only: generated_mesh
   use casca_gmsh_io, only: read_gmsh
   use casca_deck, only: deck_t, add_problem, deck_file, unset
   use casca_sanity, only: parse_fix
@@ -38,16 +38,11 @@ contains
     integer :: i
     real(dp) :: rot(3, 3)
     associate (b => deck%bodies(ib))
-      select case (b%mesh)
-      case ('ring')
-        call mesh_ring(b%radius, b%width, b%n_around, b%n_across, mesh, err)
-      case ('sphere')
-        call mesh_sphere(b%radius, b%n_div, mesh, err)
-      case ('plate', 'strip')
-        call mesh_plate(b%lx, b%ly, b%nx, b%ny, mesh, err)
-      case ('file')
+      if (b%mesh == 'file') then
         call read_gmsh(deck_file(deck, b%file), mesh, err)
-      end select
+      else
+        call generated_mesh(b, mesh, err)
+      end if
       if (allocated(err)) return
       if (b%flip_normals) then
         call reverse_elements(mesh%conn)
