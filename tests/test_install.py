@@ -5,7 +5,8 @@ Installs the build into a fresh temporary prefix (WORK_DIR/prefix, removed first
 - PREFIX/bin/casca is an executable file;
 - PREFIX/share/casca/examples holds every examples/*.nml of the source tree, and every mesh
   file an installed deck names (`file = '...'`, relative to the deck) exists there;
-- PREFIX/share/doc/casca holds README.md and docs/method.md, identical to the source's;
+- PREFIX/share/doc/casca holds README.md, docs/method.md and docs/deck.md (the deck
+  reference README.md links to), identical to the source's;
 - the installed `casca --version` and `casca check` of every installed example exit 0;
 - the installed `casca run` of a copy of the installed two_rings.nml, kept next to it (so its
   ../mesh/ring_20x1.msh is the installed mesh) with t_end = 2 ms and output every 1 ms, exits 0
@@ -49,10 +50,10 @@ for d in installed:
 ck.record("every mesh an installed deck names is installed at its relative path",
           len(installed) > 0 and not missing, ", ".join(missing))
 doc = os.path.join(prefix, "share", "doc", "casca")
-ck.record("README.md and docs/method.md installed under share/doc/casca, as in the source",
+ck.record("README.md, docs/method.md and docs/deck.md installed under share/doc/casca, as in the source",
           all(os.path.isfile(os.path.join(doc, f)) and filecmp.cmp(os.path.join(doc, f), os.path.join(source, f),
                                                                     shallow=False)
-              for f in ("README.md", os.path.join("docs", "method.md"))))
+              for f in ("README.md", os.path.join("docs", "method.md"), os.path.join("docs", "deck.md"))))
 
 p = run([casca, "--version"], cwd=work)
 ck.record("installed casca --version: exit 0", p.returncode == 0 and p.stdout.startswith("casca "),
