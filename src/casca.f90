@@ -309,6 +309,8 @@ contains
     end if
     call load_scene(arg(2), deck, model, code, gaps=.true.)
     if (code == exit_ok .and. is_root()) call starter_report(deck, model, 6, 0)
+    if (code == exit_ok .and. is_root() .and. deck%run%title /= '') &
+      print '(a)', arg(2)//': '//trim(deck%run%title)
     if (code == exit_ok .and. is_root()) print '(a)', arg(2)//': ok: '// &
       count_of(model%nbody, 'body', 'bodies')//', '//count_of(model%nelem, 'element', 'elements')// &
       ', '//count_of(model%nnode, 'node', 'nodes')//', '// &

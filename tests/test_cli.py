@@ -141,6 +141,8 @@ ck.record("casca check of a one-body deck: '1 body,'", p.returncode == 0 and ": 
 p = run([casca, "check", os.path.join(examples, "two_rings.nml")])
 ck.record("casca check of a two-body deck: '2 bodies,'", p.returncode == 0 and ": ok: 2 bodies, " in p.stdout,
           p.stdout.strip()[:200])
+ck.record("casca check names the deck's &run title (two_rings.nml: 'two rings') beside the deck's path",
+          p.returncode == 0 and "two_rings.nml: two rings\n" in p.stdout, p.stdout.strip()[-300:])
 p = run([casca, "mesh", "plate", "--nx", "1", "--ny", "1", "-o", os.path.join(work, "one_cell.msh")])
 ck.record("casca mesh: '2 elements, 16 nodes'", p.returncode == 0 and
           p.stdout.strip().endswith(": 2 elements, 16 nodes"), p.stdout.strip())

@@ -192,6 +192,8 @@ contains
     call catch_stop_signals()   ! (from here a signal stops the run at a step's end, kept)
     call load_scene(path, r%deck, r%model, r%code)
     if (r%code /= exit_ok) return
+    if (is_root() .and. .not. r%quiet .and. r%deck%run%title /= '') &
+      print '(a)', 'casca: '//trim(r%deck%run%title)
     allocate (r%ls)
     r%dir = trim(r%deck%output%dir)
     if (out_dir /= '') r%dir = trim(out_dir)
