@@ -1015,7 +1015,7 @@ contains
       rate = (now - last%wall)/max(st%t - last%t, tiny(1._dp))
       nc = 0
       if (allocated(r%contact)) nc = r%contact%set%nact
-      print '(a,i7,a,es11.4,a,es9.2,a,f5.2,a,i4,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
+      print '(a,i7,a,es11.4,a,es9.2,a,f6.2,a,i5,a,f8.1,a,f8.1,a)', 'step', st%step, '  t', st%t, &
         '  dt', r%nm%dt, '  newton/step', real(r%total_newton - last%newton)/max(st%step - last%step, 1), &
         '  contacts', nc, '  elapsed', now - r%t0, ' s  left', rate*max(r%deck%run%t_end - st%t, 0._dp), ' s'
       flush (output_unit)   ! (read as it goes from a file or a batch system's log, and kept if the run is killed)
