@@ -17,6 +17,7 @@ module casca_deck
   use, intrinsic :: iso_fortran_env, only: iostat_end, iostat_eor
   use casca_files, only: file_kind, kind_special, kind_folder
   use casca_kinds, only: dp
+  use casca_strings, only: itoa
   use casca_deck_lint, only: lint_group, outside_text, lower
   implicit none
   private
@@ -197,23 +198,17 @@ contains
     type(deck_t), intent(inout) :: deck
     integer, intent(in) :: line_given
     character(len=*), intent(in) :: msg
-    character(len=512), allocatable :: tmp(:)
-    character(len=16) :: ls
+    character(len=512) :: text
     integer :: line
     line = key_line_of(deck, line_given, msg)
-    if (.not. allocated(deck%problems)) allocate (deck%problems(16))
-    if (deck%nproblems == size(deck%problems)) then
-      allocate (tmp(2*size(deck%problems)))
-      tmp(1:deck%nproblems) = deck%problems(1:deck%nproblems)
-      call move_alloc(tmp, deck%problems)
-    end if
-    deck%nproblems = deck%nproblems + 1
     if (line > 0) then
-      write (ls, '(i0)') line
-      deck%problems(deck%nproblems) = deck%path//':'//trim(ls)//': '//msg
+      text = deck%path//':'//itoa(line)//': '//msg
     else
-      deck%problems(deck%nproblems) = deck%path//': '//msg
+      text = deck%path//': '//msg
     end if
+    if (.not. allocated(deck%problems)) allocate (deck%problems(0))
+    deck%problems = [deck%problems, text]
+    deck%nproblems = size(deck%problems)
   end subroutine add_problem
 
   !> The line of the key a message names after its group ('&body a: poisson must ...'), if
