@@ -17,12 +17,14 @@ module casca_run_state
   implicit none
   private
   public :: run_t, least_t, progress_t
-  public :: exit_ok, exit_input, exit_solver, exit_signal, cap_hold, newton_share, newton_floor, svk_limit
+  public :: exit_ok, exit_input, exit_solver, exit_signal, cap_hold, easy_hold, newton_share, newton_floor, svk_limit
 
   integer, parameter :: exit_ok = 0, exit_input = 2, exit_solver = 3, exit_signal = 4
   !> with an error-controlled step: the energy's cap (run_t%dt_cap) doubles after this many of
   !> its lengths
   real(dp), parameter :: cap_hold = 20
+  !> and after this many at a step that removed energy (where the energy does not limit it)
+  real(dp), parameter :: easy_hold = 4
   !> under &run tolerance, Newton's tolerance is at most this share of the error asked for,
   !> and not below newton_floor (of the scene size: round-off's reach)
   real(dp), parameter :: newton_share = 1e-5_dp, newton_floor = 1e-12_dp
