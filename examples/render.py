@@ -6,7 +6,8 @@ speed (the thesis' Figs. 8 and 14). Run with ParaView's batch interpreter:
 writes out/two_rings/frame_t<time>.png for each time (the nearest frame's time, 6 digits). Every picture has
 the same camera and colour range, so that they compare: the camera looks along the thinnest
 side of the box holding all bodies in all the chosen frames (down the axis of the rings; when
-no side is under half the longest, as for a ball, along y with z up),
+no side is under half the longest, as for a ball, along y with z up), turned TILT degrees up
+and half that sideways so that a band or a plate is not seen edge-on,
 with the box's longest side across the picture, and shows the whole box; the colours run
 from 0 to the highest speed in those frames. A static run's frames (no velocities; t is the
 load factor) are coloured by the displacement's magnitude and labelled with the load factor."""
@@ -14,12 +15,13 @@ import math
 import os
 import sys
 
-from paraview.simple import (Calculator, ColorBy, GetActiveViewOrCreate, GetColorTransferFunction,
-                             GetScalarBar, PVDReader, Render, SaveScreenshot, Show, Text,
+from paraview.simple import (Calculator, ColorBy, GetActiveCamera, GetActiveViewOrCreate,
+                             GetColorTransferFunction, GetScalarBar, PVDReader, Render, SaveScreenshot, Show, Text,
                              UpdatePipeline)
 
 WIDTH, HEIGHT = 1200, 700
 MARGIN = 1.3   # room around the bodies (and for the colour bar), as a factor on the box
+TILT = 25.0    # degrees off the thinnest side
 
 
 def nearest_frames(reader, times):
@@ -59,6 +61,11 @@ def place_camera(view, box):
     view.CameraFocalPoint = centre
     view.CameraPosition = position
     view.CameraViewUp = [1.0 if i == up else 0.0 for i in range(3)]
+    # turned a little off the thin side: straight along it a ring's band or a plate is seen
+    # edge-on, a hairline that breaks up
+    camera = GetActiveCamera()
+    camera.Elevation(TILT)
+    camera.Azimuth(-0.5 * TILT)
 
 
 folder = sys.argv[1]
