@@ -3,7 +3,8 @@ two runs in one folder, foreign checkpoints, shell injection, non-finite numbers
 one of two MPI ranks. Each case asserts exit codes and file contents against an independent
 answer (an uninterrupted run, the file system, the deck's own numbers). Among them: a run
 into a finished run's folder, stopped by SIGTERM, leaves none of that run's plots (plots.gp,
-gnuplot.log, PNGs), while a restart in place keeps them; on a full disk (as root only: a
+gnuplot.log, PNGs), while a restart in place keeps them; a SIGTERM during a static load step
+ends the run within a small part of that step at the last converged one (exit 4); on a full disk (as root only: a
 small tmpfs is mounted, else skipped) the restart hint is printed exactly when a checkpoint is
 left, and stopped.txt, written where there is room for it (at one size at least), names the
 failed write.
@@ -192,6 +193,87 @@ for ranks, sig in ((1, signal.SIGTERM), (2, signal.SIGUSR1)):
               p.returncode == 0 and not os.path.exists(stopped), first_line(p))
     ck.le("%s: the restarted history.dat equals the uninterrupted run's on as many ranks (max "
           "relative to each column's size)" % name, max_rel(h, ref_h), 1e-12)
+
+# --- statics: a stop signal during a load step is served between Newton solves, not at the
+# step's end: a load step can take minutes (a plate held by friction, halved and stabilised
+# 190 s past a SIGTERM, validator S33 F4). The strip rolled up in three load steps, the third
+# of them ~3/4 of the run (Newton halves it again and again), SIGTERM half a second into it:
+# exit 4 within a quarter of the uninterrupted run's time, stopped.txt names the signal, the
+# checkpoint and the history end at the last converged load step (2/3), the lock is gone, and
+# the restart from there ends where the uninterrupted run does (to Newton's tolerance). Past
+# twice the bound a second SIGTERM ends the process at once (README), leaving no stopped.txt and its
+# lock (which a later run takes over).
+static_text = """&run
+  analysis = 'static', load_steps = 3, reuse_factorisation = .false.
+/
+&output
+  dir = 'out', track = 12.0, 0.5, 0.0
+/
+&body
+  name = 'strip', mesh = 'strip', lx = 12.0, ly = 1.0, nx = 8, ny = 1
+  young = 1.2e6, poisson = 0.0, density = 1.0, thickness = 0.1
+/
+&restraint
+  body = 'strip', box_max = 0.0, 1e9, 1e9, fix = 'clamped'
+/
+&load
+  body = 'strip', box_min = 12.0, -1e9, -1e9, kind = 'edge', moment = 0.0, -52.35987755982988, 0.0
+/
+"""
+static_deck = os.path.join(work, "static_signalled.nml")
+with open(static_deck, "w") as f:
+    f.write(static_text)
+
+
+def tip(folder):
+    """The tracked tip's position (x, z) in the last row of folder's history.dat"""
+    names = open(os.path.join(folder, "history.dat")).readline().lstrip("#").split()
+    last = np.atleast_2d(np.loadtxt(os.path.join(folder, "history.dat")))[-1]
+    return np.array([last[names.index("p1_x")], last[names.index("p1_z")]])
+
+
+static_ref = os.path.join(work, "static_ref")
+t0 = time.time()
+p = run([casca, "run", static_deck, "-q", "--out", static_ref])
+t_ref = time.time() - t0
+ck.record("statics: the uninterrupted run (exit 0)", p.returncode == 0, first_line(p))
+static_out = os.path.join(work, "static_signalled")
+proc = subprocess.Popen([casca, "run", static_deck, "-q", "--out", static_out], env=ENV,
+                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+hist = os.path.join(static_out, "history.dat")
+while proc.poll() is None and (not os.path.exists(hist) or open(hist).read().count("\n") < 4):
+    time.sleep(0.01)   # (the header and the rows of factors 0, 1/3 and 2/3)
+time.sleep(0.5)
+t_sig = time.time()
+proc.send_signal(signal.SIGTERM)
+try:   # (past twice the bound a second SIGTERM, as a batch system's SIGKILL after its grace period)
+    proc.communicate(timeout=t_ref / 2)
+except subprocess.TimeoutExpired:
+    proc.send_signal(signal.SIGTERM)
+    proc.communicate(timeout=600)
+t_stop = time.time() - t_sig
+stopped = os.path.join(static_out, "stopped.txt")
+said = open(stopped).read() if os.path.exists(stopped) else ""
+ck.record("statics: SIGTERM during a load step: exit 4 and stopped.txt names it",
+          proc.returncode == 4 and "SIGTERM" in said, "exit %d; %r" % (proc.returncode, said[:120]))
+ck.le("statics: seconds from the (first) SIGTERM to the exit (bound: a quarter of the uninterrupted run's "
+      "%.1f s, most of which is the last load step)" % t_ref, t_stop, t_ref / 4)
+ck_step, ck_t = -1, np.nan
+if os.path.exists(os.path.join(static_out, "checkpoint.h5")):
+    with h5py.File(os.path.join(static_out, "checkpoint.h5"), "r") as f:
+        ck_step, ck_t = int(f["step"][()]), float(f["t"][()])
+rows = np.atleast_2d(np.loadtxt(hist))
+ck.record("statics: the checkpoint and history.dat end at the last converged load step (2 of 3, "
+          "factor 2/3)", ck_step == 2 and abs(ck_t - 2 / 3) <= 1e-12 and int(rows[-1, 1]) == 2,
+          "checkpoint step %d factor %.17g, last row step %d" % (ck_step, ck_t, rows[-1, 1]))
+ck.record("statics: the folder's lock is gone", not os.path.exists(os.path.join(static_out, "casca.lock")))
+p = run([casca, "run", static_deck, "-q", "--out", static_out, "--restart",
+         os.path.join(static_out, "checkpoint.h5")])
+gap = np.max(np.abs(tip(static_out) - tip(static_ref))) if p.returncode == 0 else np.inf
+ck.record("statics: the restart from the checkpoint at factor 2/3 ends (exit 0, no stopped.txt) at the "
+          "uninterrupted run's tip, to 1e-6 of the strip's length",
+          ck_step == 2 and p.returncode == 0 and not os.path.exists(stopped) and gap <= 1e-6 * 12.0,
+          "%s; tip off by %.3g" % (first_line(p), gap))
 
 # --- a restart from a finished run's own checkpoint: its time is t_end but for the rounding
 # of a sum of 80 steps (4.0000000000000036e-3), and it is accepted, takes no step and leaves

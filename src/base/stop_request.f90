@@ -1,7 +1,8 @@
 !> A request to stop the run (SIGTERM, SIGINT or SIGUSR1: a batch system's time limit, Ctrl-C,
 !> or `kill -USR1` sent to mpirun, which kills its ranks about a second after a SIGTERM but
 !> passes SIGUSR1 on): caught by sysinfo.c and seen by the time loop at a step's end, where the
-!> state is whole and a checkpoint of it can be written.
+!> state is whole and a checkpoint of it can be written; statics also looks between Newton
+!> solves within a load step, which it then abandons for the last converged one.
 module casca_stop_request
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   use casca_mpi, only: max_all

@@ -506,6 +506,8 @@ contains
     type(run_t), intent(inout) :: r
     integer :: i, stabilised, sig, nsteps
     real(dp) :: next_ckpt
+    real(dp), allocatable :: q_start(:)
+    type(contact_t), allocatable :: contact_start
     associate (deck => r%deck, st => r%st)
       nsteps = merge(1, deck%run%load_steps, deck%run%linear)
       next_ckpt = huge(1._dp)
@@ -516,10 +518,16 @@ contains
         if (.not. row_and_frame(r, 0)) return
       end if
       do i = st%step + 1, nsteps
+        q_start = st%q
+        if (allocated(r%contact)) contact_start = r%contact
         call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/nsteps, &
                           deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, stabilised, r%contact)
         if (allocated(r%err)) then
-          call give_up(r, r%err%message); return
+          if (stop_requested() > 0) then   ! (the step under way abandoned: the last converged kept)
+            st%q = q_start
+            if (allocated(r%contact)) r%contact = contact_start
+          end if
+          call give_up(r, r%err%message); return   ! (which stops for the signal)
         end if
         st%t = real(i, dp)/nsteps; st%step = i
         call account_state(r, factor=st%t)   ! (issue 17)
@@ -1076,6 +1084,11 @@ contains
     type(run_t), intent(inout) :: r
     character(len=*), intent(in) :: why
     character(len=:), allocatable :: reason
+    integer :: sig
+    sig = stop_requested()
+    if (sig > 0) then   ! (a stop asked for before or during the failure: what the user wants told)
+      call stop_on_request(r, sig); return
+    end if
     reason = why   ! (why may be r%err's message, which the frame and checkpoint below reset)
     if (is_root()) write (0, '(a)') 'error: the solver cannot go on '//when(r)//': '//reason
     ! (an earlier step that made energy is often the cause: a node come in edge-on)
@@ -1133,13 +1146,13 @@ contains
     end if
   end function when
 
-  !> A stop signal came (stop_request): the step under way was finished; keep its state as
-  !> a frame and checkpoint and stop with exit_signal, so that --restart goes on from here
+  !> A stop signal came (stop_request): the step under way was finished (or, in statics,
+  !> abandoned: a load step can take minutes); keep the last step's state as a frame and
+  !> checkpoint and stop with exit_signal, so that --restart goes on from here
   subroutine stop_on_request(r, sig)
     type(run_t), intent(inout) :: r
     integer, intent(in) :: sig
-    if (is_root()) write (0, '(a,es12.5,a)') 'casca: '//signal_name(sig)//' received; stopped at t = ', &
-      r%st%t, ' s, at the end of the step under way'
+    if (is_root()) write (0, '(a)') 'casca: '//signal_name(sig)//' received; stopped '//when(r)
     call keep_and_stop(r, 'stopped by '//signal_name(sig))
     if (r%code == exit_ok) r%code = exit_signal
   end subroutine stop_on_request

@@ -30,6 +30,7 @@ module casca_statics
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
   use casca_time_scheme, only: newmark_scheme
+  use casca_stop_request, only: stop_requested
   implicit none
   private
   public :: static_solve
@@ -53,7 +54,8 @@ contains
   !> take 16 (1,041 in all); a snap-through, which no halving passes, spends about a
   !> quarter more on the failed tries (Sze's pinched cylinder: 1,312 for 1,057). q holds
   !> the start and the result; on failure it is the last converged state and err says at
-  !> which factor.
+  !> which factor. A stop signal ends it between Newton solves with err set and q anywhere:
+  !> the caller abandons the load step (stop_pending).
   subroutine static_solve(model, asm, ls, fext, from, to, max_cuts, opts, q, rep, err, &
                           stabilised, contact)
     type(model_t), intent(in) :: model
@@ -77,6 +79,7 @@ contains
     at = from; level = 0; iters = 0; unheld = .false.; stabilised = 0; tries = 0; probed = .false.; damped = ''
     if (present(contact)) contact%opt%stick_at_touch = .true.
     do while (at < to - 1e-12_dp*abs(to - from))
+      if (stop_pending(err)) return
       step = min((to - from)/2**level, to - at)
       if (present(contact)) then   ! (friction's slip is over the load increment)
         do k = 1, contact%set%nact
@@ -135,6 +138,15 @@ contains
     end do
     rep%iters = iters
   end subroutine static_solve
+
+  !> A stop signal came (stop_request): err says so. Asked between Newton solves, as a load
+  !> step's halvings and up to max_stages stabilised stages ran 190 s past a batch system's
+  !> SIGTERM (validator S33, F4); the caller keeps the last converged load step.
+  logical function stop_pending(err)
+    type(error_t), allocatable, intent(inout) :: err
+    stop_pending = stop_requested() > 0
+    if (stop_pending) call fatal_error(err, 'a stop signal came during the load step')
+  end function stop_pending
 
   !> The last increment a tenth of the one before or less (Newton near its end)
   logical pure function converging(rep)
@@ -197,6 +209,7 @@ contains
     iters = 0; moving = 0; fs = 0; c_fail = 0; unheld = .false.
     fs_before = 0; fs_tried = huge(1._dp)
     do stage = 1, max_stages
+      if (stop_pending(err)) return   ! (q and the contacts as they are: static_solve's comment)
       call newton_solve(model, asm, ls, q, fext, fresh, rep, err, cm=c, qs=c*q_n, &
                         contact=contact, load_factor=factor)
       iters = iters + rep%iters
