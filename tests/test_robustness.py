@@ -95,7 +95,9 @@ buckling     a static path past a buckling point is told: a clamped column (stri
              that it first had negative pivots at load factor 0.7 and none at 0.6 (the steps
              around Euler's 0.667), and history.dat's neg_pivots is 0 up to 0.6 and 1 from
              0.7 (kept factors of the unloaded state hid it before). At 0.9 times Euler's load
-             there is no warning and no negative pivot.
+             there is no warning and no negative pivot. At 1.5 times in one load step the
+             warning names 0 (the unloaded state) and 1, Euler's 0.667 between, and neg_pivots
+             is 1 (the inertia of the step's start and no warning before, validator S33 F1).
 """
 import glob
 import os
@@ -620,16 +622,16 @@ if "buckling" in CASES:
     t0 = time.time()
     E, L, b, hh = 1e9, 1.0, 0.1, 0.01
     euler = np.pi ** 2 * E * b * hh ** 3 / 12 / (4 * L ** 2)
-    for label, share in (("over", 1.5), ("under", 0.9)):
+    for label, share, steps in (("over", 1.5, 10), ("under", 0.9, 10), ("one_step", 1.5, 1)):
         deck = os.path.join(work, "buckling_%s.nml" % label)
         with open(deck, "w") as f:
-            f.write("""&run analysis = 'static', load_steps = 10 /
+            f.write("""&run analysis = 'static', load_steps = %d /
 &output vtu = .false., plots = .false. /
 &body name = 'column', mesh = 'strip', lx = %r, ly = %r, nx = 16, ny = 1,
   young = %r, poisson = 0.0, density = 1000.0, thickness = %r /
 &restraint body = 'column', box_max = 0.0, 1e9, 1e9, fix = 'clamped' /
 &load body = 'column', box_min = %r, -1e9, -1e9, kind = 'edge', force = %r, 0.0, 0.0 /
-""" % (L, b, E, hh, L, -share * euler))
+""" % (steps, L, b, E, hh, L, -share * euler))
         h, ok = run_deck("buckling_" + label, deck)
         warned = re.search(r"negative pivots from load factor (\S+) on \(at most (\d+); none at (\S+)\)",
                            LAST_STDERR[0])
@@ -642,6 +644,14 @@ if "buckling" in CASES:
                 neg = h["neg_pivots"][h["t"] > 0]
                 ck.record("buckling, 1.5 x Euler: neg_pivots 0 at factors 0.1 to 0.6, 1 at 0.7 to 1",
                           list(neg) == [0] * 6 + [1] * 4, str(list(neg)))
+        elif label == "one_step":
+            ck.record("buckling, 1.5 x Euler in one load step: warned, Euler's load factor 1/1.5 "
+                      "between the factors named (none at 0, the unloaded state; from 1)",
+                      warned is not None and float(warned.group(3)) < 1 / 1.5 < float(warned.group(1)),
+                      LAST_STDERR[0][-400:])
+            if h is not None:
+                ck.record("buckling, 1.5 x Euler in one load step: neg_pivots 1 at factor 1",
+                          list(h["neg_pivots"][h["t"] > 0]) == [1], str(list(h["neg_pivots"])))
         else:
             ck.record("buckling, 0.9 x Euler: no warning of negative pivots", warned is None,
                       LAST_STDERR[0][-400:])

@@ -14,7 +14,7 @@ module casca_run
   use casca_mass_solver, only: mass_setup
   use casca_start_acceleration, only: loaded_acceleration
   use casca_newmark, only: state_t, newmark_step
-  use casca_statics, only: static_solve
+  use casca_statics, only: static_solve, unloaded_inertia
   use casca_time_scheme, only: newmark_scheme, alpha_scheme
   use casca_step_control, only: local_error, depth_error, energy_error, next_step_ratio
   use casca_step_size, only: time_to_contact
@@ -516,6 +516,10 @@ contains
       if (st%step == 0) then   ! (the unloaded state, as a dynamic run's t = 0: frames and plots start undeformed)
         call account_state(r, factor=0._dp)
         if (.not. row_and_frame(r, 0)) return
+        if (.not. r%opts%linear) then   ! (the first load step's inertia is judged against it)
+          if (unloaded_inertia(r%model, r%asm, r%ls, r%fext, r%opts, st%q, r%contact) == 0) &
+            r%stability%t_before = 0
+        end if
       end if
       do i = st%step + 1, nsteps
         q_start = st%q

@@ -58,9 +58,11 @@ contains
   !> Statics: keep where the load step just taken (rep, at load factor r%st%t) had negative
   !> pivots in its tangent stiffness. The saddle-point matrix has one negative pivot per
   !> contact row besides the stiffness's own on what the rows leave free (its inertia, as
-  !> the Schur path counts it too). Counted from a load step that had none on: a body that
-  !> its contacts alone hold, or nothing (a free sphere under pressure), has zero pivots of
-  !> round-off's sign from its first step, and a stabilised step's tangent is such a one.
+  !> the Schur path counts it too). Counted from a load step that had none on, or from the
+  !> unloaded state where its own factorisation had none (static_run, unloaded_inertia: a
+  !> column past Euler's load in its first step): a body that its contacts alone hold, or
+  !> nothing (a free sphere under pressure), has zero pivots of round-off's sign from its
+  !> start, and a stabilised step's tangent is such a one.
   subroutine watch_stability(r, stabilised)
     type(run_t), intent(inout) :: r
     logical, intent(in) :: stabilised   !< the step took the stabilised path

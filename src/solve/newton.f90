@@ -87,6 +87,7 @@ module casca_newton
     integer :: neg_pivots = 0         !< of the factors in use (inertia)
     integer :: analyses = 0           !< symbolic analyses done in this solve
     integer :: factorisations = 0     !< numerical factorisations done in this solve
+    integer :: factored_at = 0        !< the iteration of the last of them (0: none)
     integer :: refreshes = 0          !< steps of kept factors undone and taken afresh
     integer :: backtracks = 0         !< line-search reductions
   end type newton_report_t
@@ -170,7 +171,7 @@ contains
         call factorise_blocks(ls, model, asm, rows, q, err)
         call timer_stop(t_factor)
         if (allocated(err)) exit
-        rep%factorisations = rep%factorisations + 1
+        rep%factorisations = rep%factorisations + 1; rep%factored_at = it
       end if
       call take_increment()
       if (allocated(err)) exit

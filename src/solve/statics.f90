@@ -27,13 +27,14 @@ module casca_statics
   use casca_linear_system, only: linear_system_t
   use casca_newton, only: newton_opts_t, newton_report_t, newton_solve, contraction
   use casca_contact, only: contact_t, constraint_t, set_restore
+  use casca_contact_rows, only: contact_newton_nrows
   use casca_contact_projection, only: positions
   use casca_contact_friction, only: friction_step_done
   use casca_time_scheme, only: newmark_scheme
   use casca_stop_request, only: stop_requested
   implicit none
   private
-  public :: static_solve
+  public :: static_solve, unloaded_inertia
 
   integer, parameter :: max_stages = 100     !< stabilised stages of one load step
   real(dp), parameter :: stage_factor = 10    !< c's change from stage to stage
@@ -129,7 +130,7 @@ contains
         deallocate (err)
         cycle
       end if
-      if (rep%factorisations == 0 .and. at + step >= to - 1e-12_dp*abs(to - from) .and. .not. opts%linear) &
+      if (rep%factored_at <= 1 .and. at + step >= to - 1e-12_dp*abs(to - from) .and. .not. opts%linear) &
         call fresh_inertia(model, asm, ls, fext*to, to, opts, q, rep, iters, contact)   ! (this state's)
       if (present(contact)) call friction_step_done(contact, newmark_scheme(0._dp, 1._dp), before, &
                                                     static=.true.)   ! (s kept: friction_step_done)
@@ -156,9 +157,10 @@ contains
   end function converging
 
   !> The inertia of the tangent at the converged state q (rep%neg_pivots), where the step
-  !> converged on factors kept from an earlier state: one Newton solve with fresh factors,
-  !> which starts within its tolerance. Kept factors would hide a buckling point: a column
-  !> at 1.5 times Euler's load took every step on the unloaded state's factors.
+  !> converged on factors made at its increment's start or kept from an earlier state: one
+  !> Newton solve with fresh factors, which starts within its tolerance. Such factors would
+  !> hide a buckling point: a column at 1.5 times Euler's load took every step on the
+  !> unloaded state's factors, and in one load step on those its first iteration made.
   subroutine fresh_inertia(model, asm, ls, fext, factor, opts, q, rep, iters, contact)
     type(model_t), intent(in) :: model
     type(assembly_t), intent(inout) :: asm
@@ -177,6 +179,39 @@ contains
     iters = iters + check%iters
     if (.not. allocated(err)) rep%neg_pivots = check%neg_pivots   ! (else q as it was)
   end subroutine fresh_inertia
+
+  !> The negative pivots of the stiffness at the unloaded state q (its contact rows' pivots left
+  !> out; -1 where the solve fails): one linear solve K(q) dq = f on copies (a Newton
+  !> iteration with fresh factors that any residual passes: at load factor 0 no force
+  !> judges it), the factors dropped after it so that the first load step starts as it
+  !> would have. The first load step's inertia is judged against it (watch_stability): a
+  !> column past Euler's load in its first step was not told (validator S33, F1).
+  integer function unloaded_inertia(model, asm, ls, fext, opts, q, contact) result(neg)
+    type(model_t), intent(in) :: model
+    type(assembly_t), intent(inout) :: asm
+    type(linear_system_t), intent(inout) :: ls
+    real(dp), intent(in) :: fext(:), q(:)
+    type(newton_opts_t), intent(in) :: opts
+    type(contact_t), intent(in), optional :: contact
+    type(contact_t), allocatable :: c
+    type(newton_opts_t) :: once
+    type(newton_report_t) :: rep
+    type(error_t), allocatable :: err
+    real(dp), allocatable :: q1(:)
+    once = opts; once%reuse = .false.; once%max_iter = 1
+    once%tol = 1e100_dp; once%force_tol = 1e100_dp   ! (as a linear analysis's)
+    q1 = q
+    if (present(contact)) then
+      c = contact
+      call newton_solve(model, asm, ls, q1, fext, once, rep, err, contact=c, load_factor=1._dp)
+      neg = rep%neg_pivots - contact_newton_nrows(c)
+    else
+      call newton_solve(model, asm, ls, q1, fext, once, rep, err, load_factor=1._dp)
+      neg = rep%neg_pivots
+    end if
+    if (allocated(err) .or. .not. rep%converged) neg = -1
+    call ls%drop_factors()
+  end function unloaded_inertia
 
   !> One load step through stabilised stages (module comment); unheld: a body kept moving.
   !> On failure q and the contact's active set are as they were at entry.
