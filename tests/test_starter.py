@@ -47,6 +47,11 @@ tracked        ring2 placed at x = 2.1 with the track point (0, 1, 0) given in i
                coordinates (1.33 m from ring2, beyond 5% of its size and its longest edge): warned, the printed distance equal to the nearest node's, computed
                here from the mesh file's nodes moved by the center (1e-4), and the percentage of
                the body's bounding-box diagonal; the placed point (2.1, 1, 0): no warning.
+seam           two unit squares of 2 x 2 cells each, side by side along x = 1, written here: as
+               two separately numbered meshes (a Gmsh seam: 3 x 2 + 1 = 7 coincident node
+               pairs along x = 1) casca check and a (linear) casca run warn, exit 0, naming the
+               body, 7 pairs, one pair's numbers and its coordinates (x = 1 there); with the
+               nodes merged, no warning; nor for the shipped examples and meshes.
 bad value      flip_normals = 3: exit 2, the message names the deck, its line and the field.
 element_size   generated ring (R 1, width 0.2), sphere (R 0.5) and plate (1 x 0.35) with
                element_size 0.1: element counts equal those counted from the geometry here
@@ -385,4 +390,74 @@ code, out, err, b = check("element_size_file", f"""&run dt = 1.0e-4, t_end = 1.0
 """)
 ck.record("element_size with a mesh file: exit 2 naming element_size", code == 2 and "element_size" in err,
           err[-300:])
+
+# a seam: two squares meshed separately, coincident nodes along x = 1 (3 n + 1 pairs)
+def two_squares(path, n, merged):
+    """two unit squares [0, 1] x [0, 1] and [1, 2] x [0, 1] of n x n cells, two cubic triangles
+    a cell, on a lattice of thirds; merged: one node per lattice point, else each square
+    numbers its own (the seam's nodes twice)"""
+    nodes, conn, index = [], [], {}
+    def node(sq, i, j):
+        key = (0 if merged else sq, i, j)
+        if key not in index:
+            index[key] = len(nodes) + 1
+            nodes.append((i / (3 * n), j / (3 * n), 0.0))
+        return index[key]
+    for sq in (0, 1):
+        for ci in range(n):
+            for cj in range(n):
+                i0, j0 = 3 * (sq * n + ci), 3 * cj
+                for a, b, c in (((0, 0), (3, 0), (3, 3)), ((0, 0), (3, 3), (0, 3))):
+                    pts = [a, b, c]
+                    for p, q in ((a, b), (b, c), (c, a)):
+                        pts += [tuple(p[k] + (q[k] - p[k]) // 3 for k in (0, 1)),
+                                tuple(p[k] + 2 * (q[k] - p[k]) // 3 for k in (0, 1))]
+                    pts.append(((a[0] + b[0] + c[0]) // 3, (a[1] + b[1] + c[1]) // 3))
+                    conn.append([node(sq, i0 + u, j0 + v) for u, v in pts])
+    write_msh(path, nodes, conn)
+    return nodes
+
+SEAM = re.compile(r"warning: body 'sq': its mesh has (\d+) pairs of distinct nodes at the same "
+                  r"position \(within \S+ m\), e\.g\. nodes (\d+) and (\d+) at \((\S+), (\S+), (\S+)\): "
+                  r"the surfaces there are not connected")
+for merged in (False, True):
+    path = os.path.join(work, "squares_%s.msh" % ("merged" if merged else "seam"))
+    xs = two_squares(path, 2, merged)
+    deck_text = f"""&run analysis = 'linear' /
+&output dir = '{work}/out_squares_{merged}' /
+&body name = 'sq', mesh = 'file', file = '{path}', {STEEL}, thickness = 0.01 /
+&restraint body = 'sq', box_max = 0.0, 9.0, 9.0, fix = 'clamped' /
+&restraint body = 'sq', box_min = 2.0, -9.0, -9.0, fix = 'clamped' /
+&load body = 'sq', kind = 'pressure', pressure = 1000.0 /
+"""
+    code, out, err, b = check("squares_" + str(merged), deck_text)
+    p = run([casca, "run", os.path.join(work, "squares_%s.nml" % merged)])
+    for what, code, err in (("check", code, err), ("run", p.returncode, p.stderr)):
+        m = SEAM.search(err)
+        if merged:
+            ck.record("two squares, nodes merged: casca %s exit 0, no seam warning" % what,
+                      code == 0 and "distinct nodes" not in err, err[-300:])
+            continue
+        ck.record("two squares meshed apart: casca %s exit 0, warned of 7 coincident pairs on body 'sq'"
+                  % what, code == 0 and m is not None and int(m.group(1)) == 7, err[-400:])
+        if m:
+            a, c = int(m.group(2)), int(m.group(3))
+            ck.record("seam (%s): the named nodes %d and %d are distinct, both at the printed point on "
+                      "x = 1" % (what, a, c), a != c and xs[a - 1] == xs[c - 1] and xs[a - 1][0] == 1.0
+                      and all(abs(float(m.group(4 + k)) - xs[a - 1][k]) < 1e-4 for k in range(3)),
+                      m.group(0)[-120:])
+# the shipped examples and meshes have none
+examples = os.path.join(os.path.dirname(meshdir), "examples")
+for name in sorted(os.listdir(examples)):
+    if name.endswith(".nml"):
+        p = run([casca, "check", name], cwd=examples)
+        ck.record("examples/%s: casca check exit 0, no seam warning" % name,
+                  p.returncode == 0 and "distinct nodes" not in p.stderr, p.stderr[-300:])
+for name in sorted(os.listdir(meshdir)):
+    if name.endswith(".msh"):
+        code, out, err, b = check("mesh_" + name[:-4], f"""&run dt = 1.0e-4, t_end = 1.0e-3 /
+&body name = 'm', mesh = 'file', file = '{os.path.join(meshdir, name)}', {STEEL}, thickness = 0.001 /
+""")
+        ck.record("mesh/%s: casca check exit 0, no seam warning" % name,
+                  code == 0 and "distinct nodes" not in err, err[-300:])
 ck.finish()

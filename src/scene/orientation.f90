@@ -1,5 +1,6 @@
 !> The orientation of a mesh of 10-node triangles: reversing it, checking that neighbouring
-!> elements agree on it, and the signed volume a closed mesh encloses.
+!> elements agree on it, the signed volume a closed mesh encloses, and distinct nodes at one
+!> position (an unmerged seam).
 !>
 !> An element's normal is the cross product of its xi1 and xi2 tangents, so it follows the
 !> order of its vertices. Two elements agree when they traverse their shared edge in opposite
@@ -14,6 +15,7 @@ module casca_orientation
   implicit none
   private
   public :: reverse_elements, edge_census_t, edge_census, signed_volume, vertex_elements
+  public :: coincident_t, coincident_nodes
 
   !> The node order of the reversed element (casca_mesh's order): vertices 1, 3, 2, so each
   !> edge's two inner nodes are taken from the other end (edge 1-3 of the new element is the
@@ -29,7 +31,70 @@ module casca_orientation
     integer :: node(2) = 0    !< ... and their shared edge's end nodes
   end type edge_census_t
 
+  !> Distinct nodes at one position: how many pairs, and the first (lowest numbers)
+  type :: coincident_t
+    integer :: pairs = 0
+    integer :: node(2) = 0
+  end type coincident_t
+
 contains
+
+  !> The pairs of distinct nodes of x(3, nnode) within tol of each other. The nodes are sorted
+  !> by their projection on a direction along no mesh line or plane a mesh is likely drawn
+  !> on (x . d, |d| = 1: two nodes within tol are within tol on it), and each is compared
+  !> with those after it until the projection differs by more than tol: n log n for the sort,
+  !> and a sweep over the few nodes whose projections fall that close.
+  pure function coincident_nodes(x, tol) result(cn)
+    real(dp), intent(in) :: x(:, :), tol
+    type(coincident_t) :: cn
+    real(dp), parameter :: d(3) = [1._dp, sqrt(2._dp), sqrt(3._dp)]/sqrt(6._dp)
+    real(dp), allocatable :: p(:)
+    integer, allocatable :: order(:)
+    integer :: k, m, i, j
+    p = matmul(d, x)
+    call sort_index(p, order)
+    do k = 1, size(order)
+      i = order(k)
+      do m = k + 1, size(order)
+        j = order(m)
+        if (p(j) - p(i) > tol) exit
+        if (norm2(x(:, i) - x(:, j)) > tol) cycle
+        cn%pairs = cn%pairs + 1
+        if (cn%node(1) == 0 .or. min(i, j) < cn%node(1)) cn%node = [min(i, j), max(i, j)]
+      end do
+    end do
+  end function coincident_nodes
+
+  !> Bottom-up merge sort: order is the permutation that sorts key ascending
+  pure subroutine sort_index(key, order)
+    real(dp), intent(in) :: key(:)
+    integer, allocatable, intent(out) :: order(:)
+    integer, allocatable :: tmp(:)
+    integer :: n, width, lo, mid, hi, i, j, k
+    n = size(key)
+    allocate (order(n), tmp(n))
+    order = [(i, i=1, n)]
+    width = 1
+    do while (width < n)
+      do lo = 1, n, 2*width
+        mid = min(lo + width - 1, n); hi = min(lo + 2*width - 1, n)
+        i = lo; j = mid + 1
+        do k = lo, hi
+          if (j > hi) then
+            tmp(k) = order(i); i = i + 1
+          else if (i > mid) then
+            tmp(k) = order(j); j = j + 1
+          else if (key(order(i)) <= key(order(j))) then
+            tmp(k) = order(i); i = i + 1
+          else
+            tmp(k) = order(j); j = j + 1
+          end if
+        end do
+      end do
+      order = tmp
+      width = 2*width
+    end do
+  end subroutine sort_index
 
   !> Reverse the orientation of every element of conn(nen, nelem): the normals flip.
   pure subroutine reverse_elements(conn)

@@ -15,8 +15,10 @@ module casca_scene
   use casca_vectors, only: cross
   use casca_obstacle, only: obstacle_t
   use casca_contact, only: contact_t, contact_init, contact_set_stiffness
-  use casca_orientation, only: reverse_elements, edge_census_t, edge_census
-  use casca_strings, only: itoa, rtoa, vtoa
+  use casca_orientation, only: reverse_elements, edge_census_t, edge_census, coincident_t, &
+                               coincident_nodes
+  use casca_strings, only: itoa, rtoa, vtoa, count_of
+  use casca_mpi, only: is_root
   implicit none
   private
   public :: build_model, initial_state, tracked_nodes, body_mesh, contact_pairs, scene_obstacles, &
@@ -73,6 +75,40 @@ contains
       '(Gmsh: ReverseMesh Surface{...}; on the surfaces that disagree)')
   end subroutine check_orientation
 
+  !> A warning (stderr, rank 0: casca check and casca run both build the model here) if body
+  !> ib's mesh has distinct nodes at one position: surfaces meshed without their shared
+  !> curves merged, which meet there unconnected (a seam: a slit if meant, else the parts
+  !> hinge or fall apart there, and a static run fails as if it buckled). Within 1e-6 of the
+  !> shortest edge between vertex nodes: a sound element's nodes lie a third of it apart at
+  !> least, 3e5 times more, and coordinates written to 16 digits (Gmsh) differ by round-off
+  !> only, 1e-16 of the scene's size.
+  subroutine check_seams(deck, ib, mesh)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: ib
+    type(mesh_t), intent(in) :: mesh
+    type(coincident_t) :: cn
+    real(dp) :: l_min
+    integer :: e, j
+    l_min = huge(1._dp)
+    do e = 1, mesh%nelem
+      do j = 1, 3
+        l_min = min(l_min, norm2(mesh%x(:, mesh%conn(j, e)) - mesh%x(:, mesh%conn(mod(j, 3) + 1, e))))
+      end do
+    end do
+    cn = coincident_nodes(mesh%x, 1e-6_dp*l_min)
+    if (cn%pairs == 0 .or. .not. is_root()) return
+    write (0, '(a)') 'warning: body '''//trim(deck%bodies(ib)%name)//''': its mesh has '// &
+      count_of(cn%pairs, 'pair', 'pairs')//' of distinct nodes at the same position (within '// &
+      rtoa(1e-6_dp*l_min)//' m), e.g. nodes '//itoa(cn%node(1))//' and '//itoa(cn%node(2))// &
+      ' at '//vtoa(mesh%x(:, cn%node(1)))//': the surfaces there are not connected, a seam (a '// &
+      'slit if meant; else the parts hinge or come apart there, and a static run fails as if '// &
+      'it buckled). To join them, build the surfaces on shared points and curves (Gmsh''s '// &
+      'built-in kernel merges coinciding ones with Geometry.AutoCoherence = 1, its default, or '// &
+      'Coherence; gmsh.model.geo.removeAllDuplicates(); OpenCASCADE: BooleanFragments, '// &
+      'gmsh.model.occ.removeAllDuplicates()), or merge the mesh''s nodes before saving it '// &
+      '(Coherence Mesh; gmsh.model.mesh.removeDuplicateNodes())'
+  end subroutine check_seams
+
   !> Rodrigues' rotation matrix (identity for a zero angle).
   pure function rotation(axis, angle) result(r)
     real(dp), intent(in) :: axis(3), angle
@@ -112,6 +148,7 @@ contains
         cycle
       end if
       call check_orientation(deck, ib, mesh)
+      call check_seams(deck, ib, mesh)
       call check_thickness(deck, ib, mesh)
       if (allocated(mesh%sets)) then
         call move_alloc(mesh%sets, sets(ib)%sets)
