@@ -3,7 +3,7 @@ forces, in statics under load control, past their snap-throughs; and MacNeal & H
 hemisphere, linear.
 
 usage: test_sze_shells.py CASCA WORK_DIR [CASE ...]
-  CASE (default all): pullout pinched roof hemisphere scordelis rollup
+  CASE (default all): pullout pinched roof hemisphere scordelis rollup smallload
 
 Each cylinder is modelled by one eighth, from casca's defaults (10 load steps), cut from
 `casca mesh ring` (cubic triangles, cells never straddle the symmetry planes), with symmetry
@@ -80,6 +80,16 @@ rollup   test 3.2: a cantilever strip (L 12, width 1, h 0.1, E 1.2e6, nu 0), 16 
          no step stabilised (its whole steps and halves run out of iterations, quarters take
          16: 1,041 iterations in all; before 2026-11-29, 5,762 on the stabilised path).
 
+smallload a simply supported square plate (1 x 1, h 0.01, steel, 8 x 8 cells of casca's plate
+         mesh; x y z and the fibre's component along the edge held on every edge) under
+         1e-2 Pa, in 10 load steps (analysis = 'static'), against the same deck's linear
+         analysis: a problem linear in the load to 1e-13 (w / h ~ 2e-6) takes the iterations
+         of any load, at most 5 a load step (casca's history), and its centre deflection is
+         the linear one within 1e-6. Until 2026-11-30 the force tolerance, 1e-6 of the load's
+         forces, lay below the internal force's round-off (eps E h |x|, whatever the load):
+         at 10 and 0.1 Pa 22 iterations a load step and halvings, at 1e-4 Pa every step
+         stabilised (a validator's F2).
+
 Every bound is against a published table or a closed form; none is copied from casca's output.
 """
 import os
@@ -92,7 +102,7 @@ import numpy as np
 from casca_testlib import Checks, history, run, run_scene
 
 casca, work = [os.path.abspath(a) for a in sys.argv[1:3]]
-CASES = sys.argv[3:] or ["pullout", "pinched", "roof", "hemisphere", "scordelis", "rollup"]
+CASES = sys.argv[3:] or ["pullout", "pinched", "roof", "hemisphere", "scordelis", "rollup", "smallload"]
 os.makedirs(work, exist_ok=True)
 ck = Checks()
 
@@ -289,5 +299,26 @@ if "rollup" in CASES:
         ck.close("%s: strain energy at M_max vs M^2 L / (2EI)" % name, hist["strain"][-1], M ** 2 * L / (2 * EI), 0.01)
         ck.record("%s: no load step took the stabilised path (stdout)" % name,
                   "load step" in stdout and "stabilised" not in stdout)
+
+if "smallload" in CASES:
+    w = {}
+    for analysis in ("linear", "static"):
+        h = run_static("smallload_" + analysis, "&run analysis = '%s' /\n"
+                       "&output vtu = .false., plots = .false., track = 0.5, 0.5, 0.0 /\n"
+                       "&body name = 'plate', mesh = 'plate', lx = 1.0, ly = 1.0, nx = 8, ny = 8,\n"
+                       "  young = 200e9, poisson = 0.3, density = 7800, thickness = 0.01 /\n"
+                       "&restraint body = 'plate', box_max = 0.0, 2, 1, fix = 'x y z gy' /\n"
+                       "&restraint body = 'plate', box_min = 1.0, -1, -1, fix = 'x y z gy' /\n"
+                       "&restraint body = 'plate', box_max = 2, 0.0, 1, fix = 'x y z gx' /\n"
+                       "&restraint body = 'plate', box_min = -1, 1.0, -1, fix = 'x y z gx' /\n"
+                       "&load body = 'plate', kind = 'pressure', pressure = 1.0e-2 /\n"
+                       "&contact enabled = .false. /\n" % analysis)
+        if h is None:
+            continue
+        w[analysis] = h["p1_z"][-1]
+        if analysis == "static":
+            ck.le("smallload: the most Newton iterations of a load step at 1e-2 Pa", np.max(h["newton"][1:]), 5)
+    if len(w) == 2:
+        ck.close("smallload: centre deflection at 1e-2 Pa, static vs linear", w["static"], w["linear"], 1e-6)
 
 ck.finish()
