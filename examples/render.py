@@ -10,18 +10,22 @@ no side is under half the longest, as for a ball, along y with z up), turned TIL
 and half that sideways so that a band or a plate is not seen edge-on,
 with the box's longest side across the picture, and shows the whole box; the colours run
 from 0 to the highest speed in those frames. A static run's frames (no velocities; t is the
-load factor) are coloured by the displacement's magnitude and labelled with the load factor."""
+load factor) are coloured by the displacement's magnitude and labelled with the load factor.
+Rigid obstacles (run.pvd's part 1) are drawn grey where they are at each time, and are left
+out of the box: the camera frames the bodies."""
 import math
 import os
 import sys
+import xml.etree.ElementTree as ET
 
-from paraview.simple import (Calculator, ColorBy, GetActiveCamera, GetActiveViewOrCreate,
+from paraview.simple import (Calculator, ColorBy, ExtractBlock, GetActiveCamera, GetActiveViewOrCreate,
                              GetColorTransferFunction, GetScalarBar, PVDReader, Render, SaveScreenshot, Show, Text,
-                             UpdatePipeline)
+                             Threshold, UpdatePipeline)
 
 WIDTH, HEIGHT = 1200, 700
 MARGIN = 1.3   # room around the bodies (and for the colour bar), as a factor on the box
 TILT = 25.0    # degrees off the thinnest side
+GREY = [0.62, 0.62, 0.62]   # the obstacles'
 
 
 def nearest_frames(reader, times):
@@ -43,14 +47,18 @@ def bounds_and_top(shade, frames):
     return box, top
 
 
-def place_camera(view, box):
+def place_camera(view, box, floor=None):
     """Look along the box's thinnest side at its centre, its longest side across the picture
-    pointing right, from the distance at which the whole box fits the view angle."""
+    pointing right, from the distance at which the whole box fits the view angle. floor: the
+    axis a floor's normal is along (floor_axis), made the picture's up when it lies across it
+    (a ring dropped on a floor: the floor below it, not beside it)."""
     centre = [0.5 * (box[2 * i] + box[2 * i + 1]) for i in range(3)]
     size = [box[2 * i + 1] - box[2 * i] for i in range(3)]
     thin, up, across = sorted(range(3), key=lambda i: size[i])
     if size[thin] > 0.5 * size[across]:   # no side much thinner (a ball): a side view, z up
         thin, up, across = 1, 2, 0
+    if floor == across:
+        up, across = across, up
     half = 0.5 * MARGIN * max(size[up], size[across] * HEIGHT / WIDTH, 1e-12)
     distance = half / math.tan(math.radians(0.5 * view.CameraViewAngle)) + 0.5 * size[thin]
     # from +thin, looking along -thin with `up` up, the right-hand side is (-thin) x up:
@@ -68,10 +76,38 @@ def place_camera(view, box):
     camera.Azimuth(-0.5 * TILT)
 
 
+def floor_axis(obstacles, frame):
+    """The axis (0, 1, 2) that the first obstacle drawn flat across one is normal to (a plane
+    normal to x, y or z), or None"""
+    UpdatePipeline(frame, obstacles)
+    top = int(round(obstacles.CellData["obstacle"].GetRange()[1]))
+    for k in range(1, top + 1):
+        one = Threshold(Input=obstacles, Scalars=["CELLS", "obstacle"], LowerThreshold=k - 0.5,
+                        UpperThreshold=k + 0.5)
+        UpdatePipeline(frame, one)
+        b = one.GetDataInformation().GetBounds()
+        size = [b[2 * i + 1] - b[2 * i] for i in range(3)]
+        flat = [i for i in range(3) if size[i] <= 1e-9 * max(size)]
+        if flat:
+            return flat[0]
+    return None
+
+
+def has_obstacles(pvd):
+    """run.pvd lists obstacle files (part 1) beside the frames (part 0)"""
+    return any(d.get("part") == "1" for d in ET.parse(pvd).getroot().iter("DataSet"))
+
+
 folder = sys.argv[1]
 times = [float(t) for t in sys.argv[2:]] or [0.0]
-reader = PVDReader(FileName=os.path.join(folder, "run.pvd"))
-shade = Calculator(Input=reader, ResultArrayName="shade", Function="mag(velocity)")
+pvd = os.path.join(folder, "run.pvd")
+reader = PVDReader(FileName=pvd)
+obstacles = None
+bodies = reader
+if has_obstacles(pvd):   # the reader gives a block per part: bodies 0, obstacles 1
+    bodies = ExtractBlock(Input=reader, Selectors=["/Root/Block0"])
+    obstacles = ExtractBlock(Input=reader, Selectors=["/Root/Block1"])
+shade = Calculator(Input=bodies, ResultArrayName="shade", Function="mag(velocity)")
 frames = nearest_frames(reader, times)
 box, top = bounds_and_top(shade, frames)
 static = top == 0 and max(frames) > 0   # (no velocity after the start: statics)
@@ -97,12 +133,19 @@ bar.Title = what
 bar.ComponentTitle = ""
 bar.TitleColor = [0, 0, 0]   # the default white is lost on the white background
 bar.LabelColor = [0, 0, 0]
+floor = None
+if obstacles is not None:
+    floor = floor_axis(obstacles, frames[0])
+    shown = Show(obstacles, view)
+    shown.ColorArrayName = [None, ""]   # (a solid colour)
+    shown.AmbientColor, shown.DiffuseColor = GREY, GREY
+    shown.Ambient, shown.Diffuse = 0.4, 0.6   # (seen near edge-on a floor stays grey)
 label = Text()
 label_display = Show(label, view)
 label_display.Color = [0, 0, 0]
 
 Render(view)   # the view's first render resets the camera: place it after that one
-place_camera(view, box)
+place_camera(view, box, floor)
 lut.RescaleTransferFunction(0.0, top if top > 0 else 1.0)
 for tt in frames:
     view.ViewTime = tt

@@ -33,7 +33,8 @@ Asserted about the command line itself (issue 17):
   stop time it printed and the deck's t_end; a finished run into the folder removes it.
 - a `&restraint` or `&load` given a box and a node list exits 2 at its line (each selects on
   its own; the box was dropped); a run into a folder that holds another run's 7 frames
-  leaves its own 2 there, exactly those its run.pvd lists.
+  leaves its own 2 there, exactly those its run.pvd lists, and their 2 obstacle files (its
+  part 1).
 - frames with fixed steps: an interval of 12.5 steps of dt is warned of by `casca check` (with
   the ratio, 12.500) and the run, whose frames are at the first step ends at or past 0, 0.5 and
   1 ms (0, 0.52, 1.0 ms); an interval of 12 steps is not warned of.
@@ -422,10 +423,13 @@ stale = os.path.join(work, "stale_out")
 shutil.rmtree(stale, ignore_errors=True)
 shutil.copytree(out, stale)
 p = run([casca, "run", gap_deck, "--out", stale])
-left = sorted(f for f in os.listdir(stale) if f.startswith("frame_"))
-listed = sorted(os.path.basename(d.get("file")) for d in ET.parse(os.path.join(stale, "run.pvd")).getroot().iter("DataSet"))
-ck.record("a run into a folder with another run's 7 frames leaves only its own 2, those run.pvd lists",
-          p.returncode == 0 and left == listed == ["frame_00000.vtu", "frame_00001.vtu"], "%s, %s" % (left, listed))
+sets = list(ET.parse(os.path.join(stale, "run.pvd")).getroot().iter("DataSet"))
+for part, prefix in ("0", "frame_"), ("1", "obstacles_"):   # (the bodies; the floor)
+    left = sorted(f for f in os.listdir(stale) if f.startswith(prefix))
+    listed = sorted(os.path.basename(d.get("file")) for d in sets if d.get("part") == part)
+    ck.record("a run into a folder with another run's 7 frames leaves only its own 2 %s*, those run.pvd "
+              "lists as part %s" % (prefix, part), p.returncode == 0 and
+              left == listed == [prefix + "00000.vtu", prefix + "00001.vtu"], "%s, %s" % (left, listed))
 
 # node order: the cubic map of the written frame 0 puts points on the ring's cylinder
 m = meshio.read(os.path.join(out, frames[0][1]))

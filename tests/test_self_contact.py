@@ -89,7 +89,8 @@ def go(name, text):
 def frames(out):
     root = ET.parse(os.path.join(out, "run.pvd")).getroot()
     for d in root.iter("DataSet"):
-        yield float(d.get("timestep")), meshio.read(os.path.join(out, d.get("file"))).points
+        if d.get("part") == "0":   # (part 1: the obstacles)
+            yield float(d.get("timestep")), meshio.read(os.path.join(out, d.get("file"))).points
 
 
 def penetration(a, b):
@@ -229,6 +230,8 @@ if code == 0:
     root = ET.parse(os.path.join(out, "run.pvd")).getroot()
     least, first = [], None
     for d in root.iter("DataSet"):
+        if d.get("part") != "0":   # (the planes)
+            continue
         m = meshio.read(os.path.join(out, d.get("file")))
         x0 = m.points - m.point_data["displacement"]
         if first is None:

@@ -2,16 +2,45 @@
 """Check casca's VTU/PVD writer (src/output/vtu_writer.f90) from the outside.
 
 Usage:
-    python3 tests/test_vtu.py TEST_VTU [OUTDIR]
+    python3 tests/test_vtu.py TEST_VTU [OUTDIR [CASCA]]
 
 TEST_VTU is the test_vtu executable built from tests/test_vtu.f90, or the folder holding it.
 OUTDIR (created if missing; a fresh temporary folder if omitted) receives the files.
+CASCA, the casca program: the frames of runs are checked too (below); without it, not.
 
 The program writes two frames of a two-element mesh plus a .pvd; here they are read back with
 meshio and checked: cell type, sizes, connectivity, exact field values, and -- independently of
 the writer -- the node ORDER: the cubic Lagrange map built from the points in file order must
 reproduce the cylinder the curved element was sampled from, and the affine map of the flat one.
 If the `vtk` Python module is importable, VTK's own vtkLagrangeTriangle evaluates the cells too.
+
+With CASCA, the frames of runs (their expected values from geometry and elasticity, never from
+casca's output):
+  - obstacles: a ring dropped towards a plane floor (normal +y) beside a sphere moving at
+    v = (5, 0, 0) m/s and a fixed cylinder along z. Each frame of run.pvd (part 0) has its
+    obstacles' file listed as part 1 at the same timestep, and it exists; the field data name
+    the obstacles by their number, the cell array `obstacle`; the floor's points lie on the
+    plane (|(x - p).n| < 1e-12 of the scene's size, the ring's diameter), as a square patch
+    covering the bodies' extent in the plane (its side 1.5 times their larger extent, to
+    1e-12); the sphere's at |x - (c + v t)| = R to 1e-12 relative, t the frame's timestep,
+    and its points at t displaced from those at 0 by exactly v t (to 1e-12 of the scene),
+    their point array `velocity` = v; the cylinder's at distance R from its axis to 1e-12
+    relative, over the bodies' extent along the axis. A restart (the run to half its end, its
+    checkpoint taken on to the end) lists every frame once with its obstacles (0, 1, 2, 3 ms
+    and the first run's end, 1.5 ms); a run of the
+    same folder without obstacles leaves no obstacles_* file and no part 1.
+  - thickness: the point array `thickness` is the shell's thickness h |G| (the faces at
+    Y + (h/2)(+-1 + A) G, h |G| apart along the fibre). At t = 0 it is h at every node to
+    1e-12. A plate L x B x h (E, nu) held at x = 0 in x only (free to narrow), z = 0 at every
+    node, pulled at x = L by the dead edge force F along x (statics): uniaxial stress, the
+    first Piola-Kirchhoff stress P = F / (B h), and in Saint-Venant-Kirchhoff S = E E11 with
+    E22 = E33 = -nu E11 (the material law's inverse; exact, S linear in E), P = lambda1 S,
+    lambda1 = sqrt(1 + 2 E11): E11 solves E E11 sqrt(1 + 2 E11) = F / (B h), and the
+    thickness is h lambda3, lambda3 = sqrt(1 - 2 nu E11) (the small-strain h (1 - nu eps) is
+    4e-4 off at this load: it would fail). The frame's thickness must be that at every node
+    to 1e-10 (a uniform state the element holds exactly; Newton's tolerance: 1e-14 found),
+    and, as checks of the state itself, the loaded end's displacement (lambda1 - 1) L and the
+    width's (lambda3 - 1) B to 1e-10.
 Exits non-zero on any failure.
 """
 import os
@@ -24,7 +53,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import meshio
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from casca_testlib import Checks  # noqa: E402
+from casca_testlib import Checks, run  # noqa: E402
 
 NEN = 10
 # Must match tests/test_vtu.f90.
@@ -200,14 +229,223 @@ def check_with_vtk(path, samples):
           f"{name}: VTK sees a 3-component displacement")
 
 
+RING_DECK = """&run
+  dt = 2.0e-4, t_end = %(t_end)r
+/
+&output
+  interval = 1.0e-3
+/
+&body
+  name = 'ring', mesh = 'ring', radius = 0.2, width = 0.05, element_size = 0.04
+  center = 0.0, 0.0, 0.0, velocity = 0.0, -3.0, 0.0
+  young = 2e9, poisson = 0.3, density = 1000, thickness = %(h)r
+/
+"""
+OBSTACLES = """&obstacle
+  name = 'floor', shape = 'plane', point = 0.3, -0.21, 0.1, normal = 0.0, 1.0, 0.0
+/
+&obstacle
+  name = 'ball', shape = 'sphere', point = 0.6, 0.05, 0.01, radius = 0.1, velocity = 5.0, 0.0, 0.0
+/
+&obstacle
+  name = 'post', shape = 'cylinder', point = -0.5, 0.0, 0.3, axis = 0.0, 0.0, 2.0, radius = 0.05
+/
+"""
+RING_H = 0.004
+FLOOR_P, FLOOR_N = np.array([0.3, -0.21, 0.1]), np.array([0.0, 1.0, 0.0])
+BALL_C, BALL_R, BALL_V = np.array([0.6, 0.05, 0.01]), 0.1, np.array([5.0, 0.0, 0.0])
+POST_P, POST_A, POST_R = np.array([-0.5, 0.0, 0.3]), np.array([0.0, 0.0, 1.0]), 0.05
+
+PLATE_L, PLATE_B, PLATE_H, PLATE_E, PLATE_NU, PLATE_F = 1.0, 0.5, 0.01, 1.0e6, 0.3, 250.0
+PLATE_DECK = """&run
+  analysis = 'static', load_steps = 4
+/
+&output
+  interval = 1.0
+/
+&body
+  name = 'plate', mesh = 'plate', lx = %(L)r, ly = %(B)r, nx = 4, ny = 2
+  young = %(E)r, poisson = %(nu)r, density = 1.0, thickness = %(h)r
+/
+&restraint
+  body = 'plate', box_max = 0.0, 1e9, 1e9, fix = 'x'
+/
+&restraint
+  body = 'plate', box_max = 0.0, 0.0, 1e9, fix = 'y'
+/
+&restraint
+  body = 'plate', fix = 'z'
+/
+&load
+  body = 'plate', box_min = %(L)r, -1e9, -1e9, force = %(F)r, 0.0, 0.0, kind = 'edge'
+/
+""" % dict(L=PLATE_L, B=PLATE_B, E=PLATE_E, nu=PLATE_NU, h=PLATE_H, F=PLATE_F)
+
+
+def casca_run(casca, deck_text, work, name, out=None, extra=()):
+    """Run deck_text (written to WORK/NAME.nml) into out (WORK/NAME); True if it exits 0."""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(deck_text)
+    out = out or os.path.join(work, name)
+    p = run([casca, "run", deck, "--out", out, "-q"] + list(extra))
+    return check(p.returncode == 0, f"{name}: casca runs it (exit {p.returncode}) {p.stderr[-300:]}")
+
+
+def datasets(folder):
+    """run.pvd's (timestep, part, file) in order"""
+    root = ET.parse(os.path.join(folder, "run.pvd")).getroot()
+    return [(float(d.get("timestep")), d.get("part"), d.get("file")) for d in root.iter("DataSet")]
+
+
+def frames_and_obstacles(folder, name):
+    """[(t, frame file, obstacle file or None)]; checks that each frame (part 0) is followed
+    by its obstacles (part 1) at the same timestep, and that every listed file exists"""
+    sets = datasets(folder)
+    out = []
+    for t, part, f in sets:
+        if part == "0":
+            out.append([t, f, None])
+        elif part == "1" and out and out[-1][0] == t and out[-1][2] is None:
+            out[-1][2] = f
+        else:
+            check(False, f"{name}: run.pvd's part {part} {f} at t = {t} follows its frame")
+    missing = [f for _, f, o in out for f in (f, o) if f and not os.path.exists(os.path.join(folder, f))]
+    check(not missing, f"{name}: every file run.pvd lists exists (missing {missing})")
+    return out
+
+
+def check_obstacle_frames(folder, name):
+    """The obstacles' files of the run in folder against the obstacles' geometry"""
+    listed = frames_and_obstacles(folder, name)
+    check(len(listed) >= 3 and all(o is not None for _, _, o in listed),
+          f"{name}: {len(listed)} frames (>= 3), each with its obstacles as part 1 "
+          f"({[o for _, _, o in listed]})")
+    if not listed or any(o is None for _, _, o in listed):
+        return
+    first = None
+    for t, frame, obst in listed:
+        bodies = meshio.read(os.path.join(folder, frame)).points
+        lo, hi = bodies.min(axis=0), bodies.max(axis=0)
+        scene = 0.4   # (the ring's diameter)
+        m = meshio.read(os.path.join(folder, obst))
+        which = np.concatenate(m.cell_data["obstacle"]).reshape(-1).astype(int)
+        tris = np.concatenate([c.data for c in m.cells if c.type == "triangle"])
+        check(len(tris) == len(which) and len(which) <= 1500,
+              f"{name} t={t:g}: linear triangles only, a few hundred ({len(which)})")
+        check({k: int(v[0]) for k, v in m.field_data.items()} == {"floor": 1, "ball": 2, "post": 3},
+              f"{name} t={t:g}: field data name the obstacles 1, 2, 3 ({m.field_data})")
+        pts = {k: m.points[np.unique(tris[which == k])] for k in (1, 2, 3)}
+        check(all(len(p) > 20 for p in pts.values()), f"{name} t={t:g}: each obstacle has its points")
+        # floor: on the plane, a square about the bodies covering them
+        floor = pts[1]
+        off = np.max(np.abs((floor - FLOOR_P) @ FLOOR_N)) / scene
+        check(off < 1e-12, f"{name} t={t:g}: the floor's points on its plane ({off:.1e} of the scene < 1e-12)")
+        side = floor.max(axis=0) - floor.min(axis=0)   # (x, z: the plane's axes)
+        want = 1.5 * max(hi[0] - lo[0], hi[2] - lo[2])
+        check(abs(side[0] - want) < 1e-12 * scene and abs(side[2] - want) < 1e-12 * scene,
+              f"{name} t={t:g}: the floor a square of side 1.5 x the bodies' larger extent in it "
+              f"({side[0]:.6g} x {side[2]:.6g}, {want:.6g})")
+        centre = 0.5 * (floor.max(axis=0) + floor.min(axis=0))
+        box_centre = 0.5 * (lo + hi)
+        check(abs(centre[0] - box_centre[0]) < 1e-12 * scene and abs(centre[2] - box_centre[2]) < 1e-12 * scene,
+              f"{name} t={t:g}: the floor centred under the bodies' box")
+        # ball: on the sphere where it has moved to, displaced by v t from frame 0's
+        c = BALL_C + BALL_V * t
+        r = np.linalg.norm(pts[2] - c, axis=1)
+        err = np.max(np.abs(r - BALL_R)) / BALL_R
+        check(err < 1e-12, f"{name} t={t:g}: the ball's points at |x - (c + v t)| = R ({err:.1e} < 1e-12)")
+        if first is None:
+            first = pts[2]
+        elif len(first) == len(pts[2]):
+            moved = np.max(np.linalg.norm(pts[2] - first - BALL_V * t, axis=1)) / scene
+            check(moved < 1e-12, f"{name} t={t:g}: the ball's points moved by v t from t = 0 "
+                  f"({moved:.1e} of the scene < 1e-12)")
+        else:
+            check(False, f"{name} t={t:g}: the ball has as many points as at t = 0")
+        vel = m.point_data["velocity"][np.unique(tris[which == 2])]
+        check(np.array_equal(vel, np.tile(BALL_V, (len(vel), 1))), f"{name} t={t:g}: the ball's velocity = v")
+        # post: at R from its axis, along the bodies' extent on it
+        d = pts[3] - POST_P
+        radial = np.linalg.norm(d - np.outer(d @ POST_A, POST_A), axis=1)
+        err = np.max(np.abs(radial - POST_R)) / POST_R
+        check(err < 1e-12, f"{name} t={t:g}: the post's points at R from its axis ({err:.1e} < 1e-12)")
+        check(pts[3][:, 2].min() <= lo[2] and pts[3][:, 2].max() >= hi[2],
+              f"{name} t={t:g}: the post spans the bodies along its axis")
+
+
+def check_runs(casca, outdir):
+    work = os.path.join(outdir, "runs")
+    os.makedirs(work, exist_ok=True)
+    ring = os.path.join(work, "ring_floor")
+    if casca_run(casca, RING_DECK % dict(t_end=0.003, h=RING_H) + OBSTACLES, work, "ring_floor"):
+        check_obstacle_frames(ring, "ring_floor")
+        t0 = meshio.read(os.path.join(ring, "frame_00000.vtu")).point_data.get("thickness")
+        check(t0 is not None and np.max(np.abs(t0 - RING_H)) < 1e-12 * RING_H,
+              f"ring_floor: thickness = h at t = 0 to 1e-12 "
+              f"({'none' if t0 is None else np.max(np.abs(t0 - RING_H)) / RING_H:.1e})")
+
+    # a restart: to half the end, then on from its checkpoint in the same folder
+    restart = os.path.join(work, "restart")
+    if casca_run(casca, RING_DECK % dict(t_end=0.0015, h=RING_H) + OBSTACLES, work, "restart_a",
+                 out=restart) and \
+            casca_run(casca, RING_DECK % dict(t_end=0.003, h=RING_H) + OBSTACLES, work, "restart_b",
+                      out=restart, extra=["--restart", os.path.join(restart, "checkpoint.h5")]):
+        listed = frames_and_obstacles(restart, "restart")
+        times = [t for t, _, _ in listed]
+        # the frames of the run straight through (0, 1, 2, 3 ms) and the first run's last
+        want = [0.0, 0.001, 0.0015, 0.002, 0.003]
+        check(len(times) == len(want) and np.allclose(times, want, rtol=1e-12, atol=0)
+              and len({o for _, _, o in listed}) == len(want),
+              f"restart: run.pvd lists the frames at {want} s once each, each with its own "
+              f"obstacles ({listed})")
+        check_obstacle_frames(restart, "restart")
+
+    # the same folder without obstacles: none left from the run before
+    if casca_run(casca, RING_DECK % dict(t_end=0.001, h=RING_H), work, "no_obstacles", out=ring):
+        left = [f for f in os.listdir(ring) if f.startswith("obstacles_")]
+        check(not left, f"no_obstacles: the earlier run's obstacle files deleted ({left})")
+        check(all(part == "0" for _, part, _ in datasets(ring)), "no_obstacles: run.pvd has no part 1")
+
+    # the stretched plate's thickness against Saint-Venant-Kirchhoff's uniaxial stress
+    if casca_run(casca, PLATE_DECK, work, "plate"):
+        P = PLATE_F / (PLATE_B * PLATE_H)
+        e11 = P / PLATE_E
+        for _ in range(50):   # Newton on E e11 sqrt(1 + 2 e11) = P
+            f = PLATE_E * e11 * np.sqrt(1 + 2 * e11) - P
+            df = PLATE_E * (np.sqrt(1 + 2 * e11) + e11 / np.sqrt(1 + 2 * e11))
+            e11 -= f / df
+        lam1, lam3 = np.sqrt(1 + 2 * e11), np.sqrt(1 - 2 * PLATE_NU * e11)
+        folder = os.path.join(work, "plate")
+        last = datasets(folder)[-1]
+        check(last[0] == 1.0, f"plate: the last frame at load factor 1 ({last[0]})")
+        m = meshio.read(os.path.join(folder, last[2]))
+        x0, u = m.points - m.point_data["displacement"], m.point_data["displacement"]
+        end = np.isclose(x0[:, 0], PLATE_L)
+        side = np.isclose(x0[:, 1], PLATE_B)
+        err_u = np.max(np.abs(u[end, 0] - (lam1 - 1) * PLATE_L)) / ((lam1 - 1) * PLATE_L)
+        check(err_u < 1e-10, f"plate: end displacement (lambda1 - 1) L = {(lam1 - 1) * PLATE_L:.9g} "
+              f"to 1e-10 ({err_u:.1e}; E11 = {e11:.6g})")
+        err_w = np.max(np.abs(u[side, 1] - (lam3 - 1) * PLATE_B)) / abs((lam3 - 1) * PLATE_B)
+        check(err_w < 1e-10, f"plate: width change (lambda3 - 1) B = {(lam3 - 1) * PLATE_B:.9g} "
+              f"to 1e-10 ({err_w:.1e})")
+        th = m.point_data.get("thickness")
+        want = PLATE_H * lam3
+        err_t = None if th is None else np.max(np.abs(th - want)) / want
+        check(th is not None and err_t < 1e-10,
+              f"plate: thickness h sqrt(1 - 2 nu E11) = {want:.9g} at every node to 1e-10 "
+              f"({err_t if err_t is None else f'{err_t:.1e}'}; h (1 - nu eps) = "
+              f"{PLATE_H * (1 - PLATE_NU * (lam1 - 1)):.9g})")
+
+
 def main():
-    if len(sys.argv) not in (2, 3):
+    if len(sys.argv) not in (2, 3, 4):
         print(__doc__)
         return 2
     exe = os.path.abspath(sys.argv[1])
     if os.path.isdir(exe):
         exe = os.path.join(exe, "test_vtu")
-    outdir = os.path.abspath(sys.argv[2]) if len(sys.argv) == 3 else tempfile.mkdtemp(
+    outdir = os.path.abspath(sys.argv[2]) if len(sys.argv) >= 3 else tempfile.mkdtemp(
         prefix="casca_vtu_")
     os.makedirs(outdir, exist_ok=True)
     for f in FILES + ["cyl.pvd"]:
@@ -244,6 +482,8 @@ def main():
     for i, d in enumerate(datasets):
         check_vtu(os.path.join(outdir, d.get("file")), i + 1, samples)
 
+    if len(sys.argv) == 4:
+        check_runs(os.path.abspath(sys.argv[3]), outdir)
     print(f"{CK.passed} passed, {CK.failed} failed")
     return 0 if CK.failed == 0 else 1
 

@@ -6,7 +6,7 @@ module casca_obstacle
   use casca_kinds, only: dp
   implicit none
   private
-  public :: obstacle_t, obstacle_point, obstacle_ray_time
+  public :: obstacle_t, obstacle_point, obstacle_ray_time, unit_across
 
   type :: obstacle_t
     character(len=64) :: name = ''
@@ -79,6 +79,7 @@ contains
     end if
   end function obstacle_ray_time
 
+  !> A unit vector across the unit vector a (dot_product(u, a) = 0 exactly)
   pure function unit_across(a) result(u)
     real(dp), intent(in) :: a(3)
     real(dp) :: u(3)

@@ -36,7 +36,7 @@ module casca_run
   use casca_files, only: folder_of
   use casca_stop_request, only: catch_stop_signals, stop_requested, signal_name
   use casca_free_flight, only: idle_bodies, clear_near_contact, advance_idle
-  use casca_obstacle, only: obstacle_point
+  use casca_obstacle, only: obstacle_t, obstacle_point
   use casca_mpi, only: is_root, wall_time, n_ranks, share_error
   use casca_strings, only: count_of, rtoa, ftoa, itoa
   use casca_timers, only: timer_start, timer_stop, timer_report, seconds, t_account, t_output
@@ -992,13 +992,21 @@ contains
   subroutine frame(r)
     type(run_t), intent(inout) :: r
     real(dp), allocatable :: fc(:, :), sd(:, :)
+    type(obstacle_t), allocatable :: obs(:)
+    integer :: k
     if (.not. r%deck%output%vtu) return
     if (allocated(r%contact)) then
       allocate (fc(3, r%model%nnode), sd(1, r%model%nnode))
       call contact_nodal_fields(r%contact, r%model, fc)
       call contact_signed_distance(r%contact, r%model, r%st%q, sd(1, :))
+      obs = r%contact%obstacle
+      if (r%deck%run%analysis == 'static') then   ! (statics keep them where they are at t = 0)
+        do k = 1, size(obs)
+          obs(k)%velocity = 0
+        end do
+      end if
       call output_frame(r%out, r%model, r%st, [field('contact_force', fc), &
-                                               field('signed_distance', sd)], r%err)
+                                               field('signed_distance', sd)], r%err, obs)
     else
       call output_frame(r%out, r%model, r%st, [field_t ::], r%err)
     end if

@@ -14,7 +14,8 @@ module casca_model
   implicit none
   private
   public :: body_t, model_t, model_add_body, model_finalize, dof, element_dofs, reference_state
-  public :: area_points, thick_points, element_area, thinnest, least_face_stretch, follower_loaded
+  public :: area_points, thick_points, element_area, thinnest, thickness_stretch, least_face_stretch, &
+            follower_loaded
   public :: element_energy
 
   integer, parameter :: area_points = 7    !< 7x3 points: the fewest with exactly 6 zero modes
@@ -76,12 +77,22 @@ contains
     integer :: n
     node = 0; stretch = huge(1._dp)
     do n = 1, model%nnode
-      s = norm2(q(dof(n, 4):dof(n, 6)))*(1 - 2*abs(q(dof(n, 7))))
+      s = thickness_stretch(q, n)*(1 - 2*abs(q(dof(n, 7))))
       if (s < stretch) then
         stretch = s; node = n
       end if
     end do
   end subroutine thinnest
+
+  !> Node n's thickness now over its initial one, |G|: its faces xi3 = +-1 are at
+  !> Y + (h/2)(+-1 + A) G (casca_shell_element), h |G| apart along the fibre, and G starts as
+  !> a unit vector. A shifts both faces alike: it tilts the stretch through the thickness
+  !> about this mean (thinnest's nearer face), and leaves the thickness as it is.
+  pure real(dp) function thickness_stretch(q, n)
+    real(dp), intent(in) :: q(:)
+    integer, intent(in) :: n
+    thickness_stretch = norm2(q(dof(n, 4):dof(n, 6)))
+  end function thickness_stretch
 
   !> The node whose face is stretched least along itself (shell_face_stretch) and that stretch
   pure subroutine least_face_stretch(model, q, node, stretch)

@@ -1,5 +1,7 @@
 !> What a run leaves in its output folder (rank 0 writes, the others pass):
 !>   frame_NNNNN.vtu + run.pvd   ParaView frames with their times
+!>   obstacles_NNNNN.vtu          the rigid obstacles at frame NNNNN's time (a scene with
+!>                                obstacles), part 1 of run.pvd beside the bodies' part 0
 !>   history.dat + history.h5     one row per step: energies, momenta, contacts, tracked nodes,
 !>                                energies per body, force and contacts per contact pair
 !>   tracked.txt                  a label per tracked node (for the plots)
@@ -10,7 +12,9 @@ module casca_output
   use, intrinsic :: iso_fortran_env, only: int64
   use casca_kinds, only: dp
   use casca_error, only: error_t, fatal_error
-  use casca_model, only: model_t, dof, element_dofs, element_energy
+  use casca_model, only: model_t, dof, element_dofs, element_energy, thickness_stretch
+  use casca_obstacle, only: obstacle_t
+  use casca_obstacle_surface, only: obstacle_surfaces
   use casca_newmark, only: state_t
   use casca_accounting, only: balance_t
   use casca_shell_element, only: shell_stress, von_mises, shell_energy_force, ndof_elem
@@ -45,6 +49,7 @@ module casca_output
     type(h5_table_t) :: h5
     integer :: nframes = 0
     character(len=32), allocatable :: files(:)
+    character(len=32), allocatable :: parts(:)   !< each frame's obstacles' file ('' none)
     real(dp), allocatable :: times(:)
     integer, allocatable :: tracked(:)
     integer :: nbody = 0, npairs = 0    !< per-body and per-pair columns
@@ -133,7 +138,7 @@ contains
     out%dir = trim(dir)
     out%tracked = tracked
     out%nbody = size(bodies); out%npairs = size(pairs); out%friction = friction; out%moving = moving
-    allocate (out%files(0), out%times(0))
+    allocate (out%files(0), out%parts(0), out%times(0))
     if (.not. is_root()) return
     if (.not. make_dir(out%dir)) then
       call fatal_error(err, 'cannot create the output folder '//out%dir// &
@@ -191,8 +196,9 @@ contains
     end if
     call drop_frames()
   contains
-    !> An earlier run's frames past those this run keeps, and its run.pvd when it keeps none:
-    !> left there, ParaView's frame_* series would mix the two runs (numbered on from 0)
+    !> An earlier run's frames and obstacles past those this run keeps, and its run.pvd when
+    !> it keeps none: left there, ParaView's frame_* series would mix the two runs (numbered
+    !> on from 0)
     subroutine drop_frames()
       integer :: k
       if (out%nframes == 0) call delete_file(out%dir//'/run.pvd')
@@ -201,9 +207,14 @@ contains
         call delete_file(out%dir//'/'//frame_name(k))
         k = k + 1
       end do
+      k = out%nframes
+      do while (file_kind(out%dir//'/'//obstacles_name(k)) /= kind_missing)
+        call delete_file(out%dir//'/'//obstacles_name(k))
+        k = k + 1
+      end do
     end subroutine drop_frames
 
-    !> the frames of the earlier run.pvd with time <= tmax
+    !> the frames of the earlier run.pvd with time <= tmax, with their obstacles (part 1)
     subroutine keep_frames(tmax, e)
       real(dp), intent(in) :: tmax
       type(error_t), allocatable, intent(out) :: e
@@ -222,8 +233,13 @@ contains
           call fatal_error(e, 'restart: '//out%dir//'/run.pvd: unreadable timestep'); return
         end if
         if (tt > tmax*(1 + 1e-12_dp) + tiny(1._dp)) exit
+        if (index(buf, 'part="1"') > 0) then   ! (after its frame's line, at its time)
+          if (out%nframes > 0) out%parts(out%nframes) = buf(i2 + 6:i2 + 5 + index(buf(i2 + 6:), '"') - 1)
+          cycle
+        end if
         out%nframes = out%nframes + 1
         out%files = [character(len=32) :: out%files, buf(i2 + 6:i2 + 5 + index(buf(i2 + 6:), '"') - 1)]
+        out%parts = [character(len=32) :: out%parts, '']
         out%times = [out%times, tt]
       end do
       close (uu)
@@ -387,16 +403,26 @@ contains
     write (name, '(a,i5.5,a)') 'frame_', k, '.vtu'
   end function frame_name
 
+  !> The file of frame k's obstacles
+  pure function obstacles_name(k) result(name)
+    integer, intent(in) :: k
+    character(len=19) :: name
+    write (name, '(a,i5.5,a)') 'obstacles_', k, '.vtu'
+  end function obstacles_name
+
   !> A VTU frame of the state and its entry in run.pvd. extra: more point fields (contact).
-  subroutine output_frame(out, model, st, extra, err)
+  !> obstacles: drawn where they are at the state's time, in a file of their own listed beside
+  !> the frame (part 1).
+  subroutine output_frame(out, model, st, extra, err, obstacles)
     type(output_t), intent(inout) :: out
     type(model_t), intent(in) :: model
     type(state_t), intent(in) :: st
     type(field_t), intent(in) :: extra(:)
     type(error_t), allocatable, intent(out) :: err
-    real(dp), allocatable :: x(:, :), u(:, :), v(:, :), g(:, :), a(:, :), body(:, :)
+    type(obstacle_t), intent(in), optional :: obstacles(:)
+    real(dp), allocatable :: x(:, :), u(:, :), v(:, :), g(:, :), a(:, :), body(:, :), thick(:, :)
     type(field_t), allocatable :: cell_stress(:), point_stress(:)
-    character(len=32) :: name
+    character(len=32) :: name, part
     integer :: n
     if (.not. is_root()) return
     if (size(out%times) > 0) then   ! (a run stopped just after a frame keeps that one)
@@ -407,13 +433,14 @@ contains
       return
     end if
     allocate (x(3, model%nnode), u(3, model%nnode), v(3, model%nnode), g(3, model%nnode), &
-              a(1, model%nnode))
+              a(1, model%nnode), thick(1, model%nnode))
     do n = 1, model%nnode
       x(:, n) = st%q(dof(n, 1):dof(n, 3))
       u(:, n) = x(:, n) - model%x0(:, n)
       v(:, n) = st%qd(dof(n, 1):dof(n, 3))
       g(:, n) = st%q(dof(n, 4):dof(n, 6))
       a(1, n) = st%q(dof(n, 7))
+      thick(1, n) = model%body(model%node_body(n))%thickness*thickness_stretch(st%q, n)
     end do
     body = reshape(real(model%elem_body, dp), [1, model%nelem])
     call stress_fields(model, st%q, cell_stress, point_stress)
@@ -423,16 +450,46 @@ contains
     ! geometry in the current configuration: ParaView shows the deformed shells directly
     call write_vtu(out%dir//'/'//trim(name), x, model%conn, &
                    [field('displacement', u), field('velocity', v), field('fibre', g), &
-                    field('thickness_param', a), extra, point_stress], &
+                    field('thickness_param', a), field('thickness', thick), extra, point_stress], &
                    [field('body', body), field('strain_energy', cell_energy(model, st%q)), &
                     cell_stress, field('mesh_indicator', reshape(out%ind%rel, [1, model%nelem]), &
                                        single=.true.)], err)
     if (allocated(err)) return
+    part = ''
+    if (present(obstacles)) then
+      if (size(obstacles) > 0) then
+        part = obstacles_name(out%nframes)
+        call write_obstacles(out%dir//'/'//trim(part), obstacles, st%t, x, err)
+        if (allocated(err)) return
+      end if
+    end if
     out%nframes = out%nframes + 1
     out%files = [character(len=32) :: out%files, name]
+    out%parts = [character(len=32) :: out%parts, part]
     out%times = [out%times, st%t]
-    call write_pvd(out%dir//'/run.pvd', out%files, out%times, err)
+    call write_pvd(out%dir//'/run.pvd', out%files, out%times, err, out%parts)
   end subroutine output_frame
+
+  !> The obstacles at time t, drawn about the bodies' points x (casca_obstacle_surface), to
+  !> path: per cell the obstacle's number (in the deck's order; the field data name them),
+  !> per point its velocity
+  subroutine write_obstacles(path, obstacles, t, x, err)
+    character(len=*), intent(in) :: path
+    type(obstacle_t), intent(in) :: obstacles(:)
+    real(dp), intent(in) :: t, x(:, :)
+    type(error_t), allocatable, intent(out) :: err
+    real(dp), allocatable :: p(:, :), v(:, :)
+    integer, allocatable :: tri(:, :), which(:)
+    integer :: k
+    call obstacle_surfaces(obstacles, t, x, p, tri, which)
+    allocate (v(3, size(p, 2)))
+    do k = 1, size(tri, 2)
+      v(:, tri(:, k)) = spread(obstacles(which(k))%velocity, 2, 3)
+    end do
+    call write_vtu(path, p, tri, [field('velocity', v)], &
+                   [field('obstacle', reshape(real(which, dp), [1, size(which)]))], err, &
+                   labels=[(obstacles(k)%name, k=1, size(obstacles))])
+  end subroutine write_obstacles
 
   !> The end report's lines of the mesh indicator (one per body) and its warnings for the
   !> state st: the last frame's when it was written at st's step, else computed now (vtu =

@@ -12,7 +12,10 @@
 !> a later block's raw offset made it read the wrong array (a 10 x 1 strip's frame:
 !> von_mises_top rewritten to 25888, the raw offset of the cells' offsets). Reversed, the
 !> block it looks for always comes before the rewritten ones. ParaView follows the offsets.
-!> A .pvd collection lists the frames with their times.
+!> Linear triangles (VTK_TRIANGLE, type 5) are written the same way, for drawn surfaces that
+!> are not shells (the rigid obstacles): the cell type follows conn's number of rows.
+!> A .pvd collection lists the frames with their times, and a second part per frame (part 1:
+!> the obstacles) where one is given.
 !>
 !> Every file is written to <path>.part and renamed onto <path> only when complete and closed,
 !> so a reader (or a crash) never sees a half-written file under the final name. rename(2) on
@@ -35,7 +38,7 @@ module casca_vtu_writer
     logical :: single = .false.   !< written as Float32: half the bytes, 7 significant digits
   end type field_t
 
-  integer, parameter :: vtk_lagrange_triangle = 69
+  integer, parameter :: vtk_lagrange_triangle = 69, vtk_triangle = 5
   integer, parameter :: nen = 10          !< points per cubic triangle
   integer, parameter :: msg_len = 512
   character(len=*), parameter :: nl = achar(10)
@@ -56,32 +59,37 @@ contains
     if (present(single)) f%single = single
   end function field
 
-  !> Write one UnstructuredGrid of cubic triangles to path (.vtu).
-  !> x(3, nnode) coordinates; conn(10, nelem) 1-based node numbers in casca order;
-  !> point_fields(:)%v(ncomp, nnode), cell_fields(:)%v(ncomp, nelem); either may be size 0.
-  subroutine write_vtu(path, x, conn, point_fields, cell_fields, err)
+  !> Write one UnstructuredGrid of cubic (or linear) triangles to path (.vtu).
+  !> x(3, nnode) coordinates; conn(10, nelem) 1-based node numbers in casca order (or
+  !> conn(3, nelem): linear triangles); point_fields(:)%v(ncomp, nnode),
+  !> cell_fields(:)%v(ncomp, nelem); either may be size 0. labels: field data, one array named
+  !> labels(k) holding k for each k, which names the values of a cell field (the obstacles':
+  !> numbers that meshio and ParaView both read, where a string array meshio refuses)
+  subroutine write_vtu(path, x, conn, point_fields, cell_fields, err, labels)
     character(len=*), intent(in) :: path
     real(dp), intent(in) :: x(:, :)
     integer, intent(in) :: conn(:, :)
     type(field_t), intent(in) :: point_fields(:), cell_fields(:)
     type(error_t), allocatable, intent(out) :: err
+    character(len=*), intent(in), optional :: labels(:)
 
     character(len=:), allocatable :: xml, tmp
     character(len=msg_len) :: msg
     integer(int64), allocatable :: cell_offsets(:), bytes(:), offset(:)
     integer(int8), allocatable :: types(:)
-    integer :: nnode, nelem, i, k, nf, u, ios
+    integer :: nnode, nelem, npc, i, k, nf, u, ios
 
     nnode = size(x, 2)
     nelem = size(conn, 2)
+    npc = size(conn, 1)
     if (size(x, 1) /= 3) then
       call fatal_error(err, 'write_vtu: '//trim(path)//': x must have 3 rows, got ' &
                        //itoa(size(x, 1)))
       return
     end if
-    if (size(conn, 1) /= nen) then
-      call fatal_error(err, 'write_vtu: '//trim(path)//': conn must have 10 rows, got ' &
-                       //itoa(size(conn, 1)))
+    if (npc /= nen .and. npc /= 3) then
+      call fatal_error(err, 'write_vtu: '//trim(path)//': conn must have 10 or 3 rows, got ' &
+                       //itoa(npc))
       return
     end if
     ! A bad node number would make ParaView read out of bounds or silently draw garbage.
@@ -103,7 +111,7 @@ contains
     nf = size(point_fields) + size(cell_fields)
     bytes = [(field_bytes(point_fields(i)), i=1, size(point_fields)), &
              (field_bytes(cell_fields(i)), i=1, size(cell_fields)), &
-             8_int64*3*nnode, 8_int64*nen*nelem, 8_int64*nelem, 1_int64*nelem]
+             8_int64*3*nnode, 8_int64*npc*nelem, 8_int64*nelem, 1_int64*nelem]
     allocate (offset(size(bytes)))
     offset(size(bytes)) = 0
     do k = size(bytes) - 1, 1, -1
@@ -112,8 +120,9 @@ contains
     xml = '<?xml version="1.0"?>'//nl &
           //'<VTKFile type="UnstructuredGrid" version="1.0" byte_order="'//byte_order() &
           //'" header_type="UInt64">'//nl &
-          //'  <UnstructuredGrid>'//nl &
-          //'    <Piece NumberOfPoints="'//itoa(nnode)//'" NumberOfCells="'//itoa(nelem)//'">'//nl
+          //'  <UnstructuredGrid>'//nl
+    if (present(labels)) xml = xml//label_data(labels)
+    xml = xml//'    <Piece NumberOfPoints="'//itoa(nnode)//'" NumberOfCells="'//itoa(nelem)//'">'//nl
     if (size(point_fields) > 0) then
       xml = xml//'      <PointData>'//nl
       do i = 1, size(point_fields)
@@ -141,8 +150,8 @@ contains
           //'  <AppendedData encoding="raw">'//nl//'   _'
 
     ! VTK's offsets array holds the end of each cell's run in connectivity (no leading 0).
-    cell_offsets = [(int(nen, int64)*i, i=1, nelem)]
-    types = [(int(vtk_lagrange_triangle, int8), i=1, nelem)]
+    cell_offsets = [(int(npc, int64)*i, i=1, nelem)]
+    types = [(int(merge(vtk_lagrange_triangle, vtk_triangle, npc == nen), int8), i=1, nelem)]
 
     tmp = trim(path)//'.part'
     open (newunit=u, file=tmp, access='stream', form='unformatted', status='replace', &
@@ -174,11 +183,14 @@ contains
 
   !> Write a ParaView collection (.pvd) listing files(i) (names relative to the .pvd's folder)
   !> at times(i). Rewritten whole on every call so that it is valid after every frame.
-  subroutine write_pvd(path, files, times, err)
+  !> parts(i), where not blank: a second dataset at times(i), as part 1 (ParaView shows both
+  !> parts of the time together, as two blocks).
+  subroutine write_pvd(path, files, times, err, parts)
     character(len=*), intent(in) :: path
     character(len=*), intent(in) :: files(:)
     real(dp), intent(in) :: times(:)
     type(error_t), allocatable, intent(out) :: err
+    character(len=*), intent(in), optional :: parts(:)
 
     character(len=:), allocatable :: xml, tmp
     character(len=msg_len) :: msg
@@ -190,6 +202,13 @@ contains
                        //itoa(size(times))//' times')
       return
     end if
+    if (present(parts)) then
+      if (size(parts) /= size(files)) then
+        call fatal_error(err, 'write_pvd: '//trim(path)//': '//itoa(size(files))//' files but ' &
+                         //itoa(size(parts))//' parts')
+        return
+      end if
+    end if
 
     xml = '<?xml version="1.0"?>'//nl &
           //'<VTKFile type="Collection" version="0.1" byte_order="'//byte_order()//'">'//nl &
@@ -199,6 +218,9 @@ contains
       write (tbuf, '(es25.16e3)') times(i)
       xml = xml//'    <DataSet timestep="'//trim(adjustl(tbuf))//'" group="" part="0" file="' &
             //xml_escape(trim(files(i)))//'"/>'//nl
+      if (.not. present(parts)) cycle
+      if (len_trim(parts(i)) > 0) xml = xml//'    <DataSet timestep="'//trim(adjustl(tbuf)) &
+                                        //'" group="" part="1" file="'//xml_escape(trim(parts(i)))//'"/>'//nl
     end do
     xml = xml//'  </Collection>'//nl//'</VTKFile>'//nl
 
@@ -297,6 +319,19 @@ contains
       write (u, iostat=ios, iomsg=msg) nbytes(8, size(f%v, kind=int64)), f%v
     end if
   end subroutine write_field
+
+  !> The FieldData of labels: per label an Int32 array named so, holding its number
+  function label_data(labels) result(s)
+    character(len=*), intent(in) :: labels(:)
+    character(len=:), allocatable :: s
+    integer :: k
+    s = '    <FieldData>'//nl
+    do k = 1, size(labels)
+      s = s//'      <DataArray type="Int32" Name="'//xml_escape(trim(labels(k))) &
+          //'" NumberOfTuples="1" format="ascii">'//itoa(k)//'</DataArray>'//nl
+    end do
+    s = s//'    </FieldData>'//nl
+  end function label_data
 
   !> One <DataArray .../> line for appended data at offset.
   function data_array(vtk_type, name, ncomp, offset) result(s)
