@@ -84,6 +84,11 @@ module casca_contact
     !> iterate (friction_geometry), held while that slip is below slip_floor
     real(dp) :: s(3) = 0
     real(dp) :: s0(3) = 0       !< s at the solve's start (a slip that turns against it stopped)
+    !> a sliding constraint's force across s, along n x s, from Newton's last increment (its
+    !> multiplier on the row across the slip, contact_rows): the turn of the sliding force
+    !> that s takes at the next iterate, and where the iterate is the last, part of the force
+    !> that acted (friction_force)
+    real(dp) :: lturn = 0
     real(dp) :: ut(3) = 0       !< relative tangential displacement in the step
     real(dp) :: u0(3) = 0       !< (stick_at_touch) its part before the contact was made
     !> the friction force on the node at the step's start (the last step's end), for its work

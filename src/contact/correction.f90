@@ -275,7 +275,7 @@ contains
   !> one's friction with its force, - share fa: takes the forces they carried out of an
   !> acceleration (a ring spinning up on a floor, whose nodes land and lift off in turn, kept
   !> each lifted node's friction in its next step's start: 0.3224 of the normal impulse at
-  !> mu 0.3; now 0.2997)
+  !> mu 0.3; now 0.3003)
   subroutine add_impulses(ms, cons, model, y, err, share)
     type(mass_solver_t), intent(inout) :: ms
     type(constraint_t), intent(in) :: cons(:)

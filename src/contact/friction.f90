@@ -71,14 +71,13 @@ contains
   !> The sliding directions are held for the rest of the solve, each at its solve's start
   !> (s0), as before they followed the slip: Newton gives up following it where it does not
   !> converge so (nodes whose slip in the step is a hundredth of their motion, about to
-  !> stick, turned theirs by a radian from iterate to iterate: a ball rattling in a shell)
+  !> stick, turned theirs by a radian from iterate to iterate: a ball rattling in a shell).
+  !> From the next iterate on (contact_update sets s to s0): the iterate at hand was judged
+  !> with the directions it has, and if it converges its sliding forces are theirs (set to s0
+  !> here, a hoop's friction was booked 0.1 rad off the force that moved it)
   subroutine friction_hold(c)
     type(contact_t), intent(inout) :: c
-    integer :: k
     c%follow_slip = .false.; c%hold_slip = .true.
-    do k = 1, c%set%nact
-      if (c%set%act(k)%grip == slip) c%set%act(k)%s = c%set%act(k)%s0
-    end do
   end subroutine friction_hold
 
   !> After an accepted step (scheme ts): sliding constraints add their work and take their
@@ -123,7 +122,9 @@ contains
         if (a%grip == slip) then
           if (all(a%fa == 0)) a%fa = start_force(a)
           c%friction_work(a%pair) = c%friction_work(a%pair) - dot_product((1 - w)*a%fa + w*f, a%ut)
-          if (turn .and. norm2(a%ut) > 0) a%s = a%ut/norm2(a%ut)
+          if (turn .and. norm2(a%ut) > 0) then
+            a%s = a%ut/norm2(a%ut); a%lturn = 0   ! (its turn taken: fa has the force)
+          end if
         end if
         a%fa = f
       end associate
