@@ -11,6 +11,7 @@ module casca_gmsh_io
   use casca_kinds, only: dp, i8
   use casca_error, only: error_t, fatal_error
   use casca_mesh, only: mesh_t, nen, node_set_t
+  use casca_vectors, only: sort_index
   use casca_files, only: file_kind, kind_folder, kind_special, kind_regular, close_complete, &
                          delete_file, rename_file
   use, intrinsic :: iso_fortran_env, only: int64
@@ -671,8 +672,7 @@ contains
     integer :: i, k, ie, pos, n_used
     character(len=24) :: tagstr
 
-    allocate (order(raw%nnode))
-    call merge_sort_index(raw%node_tag(1:raw%nnode), order)
+    call sort_index(real(raw%node_tag(1:raw%nnode), dp), order)   ! (tags far below 2^53: exact)
     sorted_tag = raw%node_tag(order)
     do i = 2, raw%nnode
       if (sorted_tag(i) == sorted_tag(i - 1)) then
@@ -1000,35 +1000,4 @@ contains
       end if
     end do
   end function find_sorted
-
-  !> Stable bottom-up merge sort: order is the permutation that sorts key ascending.
-  pure subroutine merge_sort_index(key, order)
-    integer(i8), intent(in) :: key(:)
-    integer, intent(out) :: order(:)
-    integer, allocatable :: tmp(:)
-    integer :: n, width, lo, mid, hi, i, j, k
-    n = size(key)
-    order = [(i, i=1, n)]
-    allocate (tmp(n))
-    width = 1
-    do while (width < n)
-      do lo = 1, n, 2*width
-        mid = min(lo + width - 1, n)
-        hi = min(lo + 2*width - 1, n)
-        i = lo
-        j = mid + 1
-        do k = lo, hi
-          if (i <= mid .and. (j > hi .or. key(order(min(i, n))) <= key(order(min(j, n))))) then
-            tmp(k) = order(i)
-            i = i + 1
-          else
-            tmp(k) = order(j)
-            j = j + 1
-          end if
-        end do
-      end do
-      order = tmp
-      width = 2*width
-    end do
-  end subroutine merge_sort_index
 end module casca_gmsh_io

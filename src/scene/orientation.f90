@@ -11,7 +11,7 @@ module casca_orientation
   use casca_kinds, only: dp
   use casca_mesh, only: nen
   use casca_shape_tri10, only: subtri10
-  use casca_vectors, only: cross
+  use casca_vectors, only: cross, sort_index
   implicit none
   private
   public :: reverse_elements, edge_census_t, edge_census, signed_volume, vertex_elements
@@ -64,37 +64,6 @@ contains
       end do
     end do
   end function coincident_nodes
-
-  !> Bottom-up merge sort: order is the permutation that sorts key ascending
-  pure subroutine sort_index(key, order)
-    real(dp), intent(in) :: key(:)
-    integer, allocatable, intent(out) :: order(:)
-    integer, allocatable :: tmp(:)
-    integer :: n, width, lo, mid, hi, i, j, k
-    n = size(key)
-    allocate (order(n), tmp(n))
-    order = [(i, i=1, n)]
-    width = 1
-    do while (width < n)
-      do lo = 1, n, 2*width
-        mid = min(lo + width - 1, n); hi = min(lo + 2*width - 1, n)
-        i = lo; j = mid + 1
-        do k = lo, hi
-          if (j > hi) then
-            tmp(k) = order(i); i = i + 1
-          else if (i > mid) then
-            tmp(k) = order(j); j = j + 1
-          else if (key(order(i)) <= key(order(j))) then
-            tmp(k) = order(i); i = i + 1
-          else
-            tmp(k) = order(j); j = j + 1
-          end if
-        end do
-      end do
-      order = tmp
-      width = 2*width
-    end do
-  end subroutine sort_index
 
   !> Reverse the orientation of every element of conn(nen, nelem): the normals flip.
   pure subroutine reverse_elements(conn)
