@@ -24,7 +24,7 @@ module casca_run
                           output_flush, output_release, output_indicator_report
   use casca_vtu_writer, only: field_t, field
   use casca_mesh_indicator, only: indicator_line_len
-  use casca_contact, only: contact_t
+  use casca_contact, only: contact_t, constraint_t, set_restore
   use casca_contact_active_set, only: contact_update
   use casca_contact_rows, only: contact_force_total, contact_nodal_fields, pair_stored_energy, start_carry
   use casca_contact_probes, only: contact_penetration, contact_signed_distance
@@ -507,7 +507,7 @@ contains
     integer :: i, stabilised, sig, nsteps
     real(dp) :: next_ckpt
     real(dp), allocatable :: q_start(:)
-    type(contact_t), allocatable :: contact_start
+    type(constraint_t), allocatable :: act_start(:)
     associate (deck => r%deck, st => r%st)
       nsteps = merge(1, deck%run%load_steps, deck%run%linear)
       next_ckpt = huge(1._dp)
@@ -523,13 +523,13 @@ contains
       end if
       do i = st%step + 1, nsteps
         q_start = st%q
-        if (allocated(r%contact)) contact_start = r%contact
+        if (allocated(r%contact)) act_start = r%contact%set%act(1:r%contact%set%nact)
         call static_solve(r%model, r%asm, r%ls, r%fext, st%t, real(i, dp)/nsteps, &
                           deck%run%max_step_cuts, r%opts, st%q, r%rep, r%err, stabilised, r%contact)
         if (allocated(r%err)) then
           if (stop_requested() > 0) then   ! (the step under way abandoned: the last converged kept)
             st%q = q_start
-            if (allocated(r%contact)) r%contact = contact_start
+            if (allocated(r%contact)) call set_restore(r%contact%set, act_start)
           end if
           call give_up(r, r%err%message); return   ! (which stops for the signal)
         end if
