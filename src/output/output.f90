@@ -203,12 +203,9 @@ contains
       integer :: k
       if (out%nframes == 0) call delete_file(out%dir//'/run.pvd')
       k = out%nframes
-      do while (file_kind(out%dir//'/'//frame_name(k)) /= kind_missing)
-        call delete_file(out%dir//'/'//frame_name(k))
-        k = k + 1
-      end do
-      k = out%nframes
-      do while (file_kind(out%dir//'/'//obstacles_name(k)) /= kind_missing)
+      do while (file_kind(out%dir//'/'//frame_name(k)) /= kind_missing .or. &
+                file_kind(out%dir//'/'//obstacles_name(k)) /= kind_missing)
+        call delete_file(out%dir//'/'//frame_name(k))   ! (a missing one is left alone)
         call delete_file(out%dir//'/'//obstacles_name(k))
         k = k + 1
       end do

@@ -15,7 +15,7 @@ module casca_orientation
   implicit none
   private
   public :: reverse_elements, edge_census_t, edge_census, signed_volume, vertex_elements
-  public :: coincident_t, coincident_nodes
+  public :: coincident_t, coincident_nodes, shortest_edge
 
   !> The node order of the reversed element (casca_mesh's order): vertices 1, 3, 2, so each
   !> edge's two inner nodes are taken from the other end (edge 1-3 of the new element is the
@@ -64,6 +64,12 @@ contains
       end do
     end do
   end function coincident_nodes
+
+  !> Shortest side of the triangle of vertices xv(3, 3)
+  pure real(dp) function shortest_edge(xv) result(l)
+    real(dp), intent(in) :: xv(3, 3)
+    l = min(norm2(xv(:, 1) - xv(:, 2)), norm2(xv(:, 2) - xv(:, 3)), norm2(xv(:, 3) - xv(:, 1)))
+  end function shortest_edge
 
   !> Reverse the orientation of every element of conn(nen, nelem): the normals flip.
   pure subroutine reverse_elements(conn)

@@ -16,7 +16,7 @@ module casca_scene
   use casca_obstacle, only: obstacle_t
   use casca_contact, only: contact_t, contact_init, contact_set_stiffness
   use casca_orientation, only: reverse_elements, edge_census_t, edge_census, coincident_t, &
-                               coincident_nodes
+                               coincident_nodes, shortest_edge
   use casca_strings, only: itoa, rtoa, vtoa, count_of
   use casca_mpi, only: is_root
   implicit none
@@ -88,12 +88,10 @@ contains
     type(mesh_t), intent(in) :: mesh
     type(coincident_t) :: cn
     real(dp) :: l_min
-    integer :: e, j
+    integer :: e
     l_min = huge(1._dp)
     do e = 1, mesh%nelem
-      do j = 1, 3
-        l_min = min(l_min, norm2(mesh%x(:, mesh%conn(j, e)) - mesh%x(:, mesh%conn(mod(j, 3) + 1, e))))
-      end do
+      l_min = min(l_min, shortest_edge(mesh%x(:, mesh%conn(1:3, e))))
     end do
     cn = coincident_nodes(mesh%x, 1e-6_dp*l_min)
     if (cn%pairs == 0 .or. .not. is_root()) return

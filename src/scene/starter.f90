@@ -27,7 +27,7 @@ module casca_starter
   use casca_deck, only: deck_t, unset, frame_interval
   use casca_model, only: model_t, body_t, dof, element_dofs, area_points, element_area
   use casca_shape_tri10, only: tri10_shape, tri10_normal
-  use casca_orientation, only: edge_census_t, edge_census, signed_volume
+  use casca_orientation, only: edge_census_t, edge_census, signed_volume, shortest_edge
   use casca_strings, only: itoa, rtoa, vtoa, ftoa, count_of
   use casca_scene, only: scene_contact, initial_state, tracked_nodes, area_per_node, clearly
   use casca_newmark, only: state_t
@@ -120,12 +120,6 @@ contains
     end do
     q = minval(j)/maxval(j)
   end function element_quality
-
-  !> Shortest side of the triangle of vertices xv(3, 3)
-  pure real(dp) function shortest_edge(xv) result(l)
-    real(dp), intent(in) :: xv(3, 3)
-    l = min(norm2(xv(:, 1) - xv(:, 2)), norm2(xv(:, 2) - xv(:, 3)), norm2(xv(:, 3) - xv(:, 1)))
-  end function shortest_edge
 
   !> The starter's report of a built scene: the facts to unit out, the warnings to unit err
   subroutine starter_report(deck, model, out, err)
