@@ -34,29 +34,13 @@ import os
 import re
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from casca_checks import Checks  # noqa: E402
+
 GROUPS = ["run", "output", "body", "restraint", "load", "obstacle", "contact"]
 ROUTINE = {"run": "read_run", "output": "read_output", "body": "read_bodies",
            "restraint": "read_restraints", "load": "read_loads", "obstacle": "read_obstacles",
            "contact": "read_contact"}
-
-
-class Checks:
-    """As casca_testlib.Checks (which needs numpy): PASS/FAIL lines and the summary."""
-
-    def __init__(self):
-        self.passed = 0
-        self.failed = 0
-
-    def record(self, name, ok, detail=""):
-        if ok:
-            self.passed += 1
-        else:
-            self.failed += 1
-        print(("PASS " if ok else "FAIL ") + name + (": " + detail if detail else ""), flush=True)
-
-    def finish(self):
-        print("%d passed, %d failed" % (self.passed, self.failed))
-        sys.exit(1 if self.failed else 0)
 
 
 def strip_comments(text):

@@ -79,31 +79,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import meshio
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from casca_testlib import Checks, run, run_scene  # noqa: E402
-
-TENSION = """&run
-  analysis = 'static', load_steps = 1
-/
-&output
-  interval = 1.0, plots = .false.
-/
-&body
-  name = 'plate', mesh = 'plate', lx = 2.0, ly = 1.0, nx = %(nx)d, ny = %(ny)d
-  young = 2.0e5, poisson = 0.3, density = 1.0, thickness = 0.05
-/
-&restraint
-  body = 'plate', box_max = 0.0, 1e9, 1e9, fix = 'x'
-/
-&restraint
-  body = 'plate', box_max = 0.0, 0.0, 1e9, fix = 'y'
-/
-&restraint
-  body = 'plate', fix = 'z'
-/
-&load
-  body = 'plate', box_min = 2.0, -1e9, -1e9, force = %(F)r, 0.0, 0.0, kind = 'edge'
-/
-"""
+from casca_testlib import Checks, run, run_scene, tension_plate_deck  # noqa: E402
 
 CANTILEVER = """&run
   analysis = 'static', load_steps = 10
@@ -167,7 +143,8 @@ def uniaxial_cauchy(p, young, poisson):
 def tension(casca, work, ck):
     for nx, ny, force in ((4, 2, 100.0), (5, 3, 2000.0)):
         name = "tension_%dx%d" % (nx, ny)
-        out, stdout = run_scene(casca, ck, work, name, TENSION % dict(nx=nx, ny=ny, F=force), quiet=False)
+        deck = tension_plate_deck(2.0, 1.0, nx, ny, 2.0e5, 0.3, 0.05, force, output=", plots = .false.")
+        out, stdout = run_scene(casca, ck, work, name, deck, quiet=False)
         if out is None:
             continue
         mesh, ind, _, _, header = cells(last_frame(out))

@@ -53,7 +53,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import meshio
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from casca_testlib import Checks, run  # noqa: E402
+from casca_testlib import Checks, run, tension_plate_deck  # noqa: E402
 
 NEN = 10
 # Must match tests/test_vtu.f90.
@@ -257,29 +257,7 @@ BALL_C, BALL_R, BALL_V = np.array([0.6, 0.05, 0.01]), 0.1, np.array([5.0, 0.0, 0
 POST_P, POST_A, POST_R = np.array([-0.5, 0.0, 0.3]), np.array([0.0, 0.0, 1.0]), 0.05
 
 PLATE_L, PLATE_B, PLATE_H, PLATE_E, PLATE_NU, PLATE_F = 1.0, 0.5, 0.01, 1.0e6, 0.3, 250.0
-PLATE_DECK = """&run
-  analysis = 'static', load_steps = 4
-/
-&output
-  interval = 1.0
-/
-&body
-  name = 'plate', mesh = 'plate', lx = %(L)r, ly = %(B)r, nx = 4, ny = 2
-  young = %(E)r, poisson = %(nu)r, density = 1.0, thickness = %(h)r
-/
-&restraint
-  body = 'plate', box_max = 0.0, 1e9, 1e9, fix = 'x'
-/
-&restraint
-  body = 'plate', box_max = 0.0, 0.0, 1e9, fix = 'y'
-/
-&restraint
-  body = 'plate', fix = 'z'
-/
-&load
-  body = 'plate', box_min = %(L)r, -1e9, -1e9, force = %(F)r, 0.0, 0.0, kind = 'edge'
-/
-""" % dict(L=PLATE_L, B=PLATE_B, E=PLATE_E, nu=PLATE_NU, h=PLATE_H, F=PLATE_F)
+PLATE_DECK = tension_plate_deck(PLATE_L, PLATE_B, 4, 2, PLATE_E, PLATE_NU, PLATE_H, PLATE_F, load_steps=4)
 
 
 def casca_run(casca, deck_text, work, name, out=None, extra=()):
